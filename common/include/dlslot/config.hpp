@@ -1,0 +1,68 @@
+// YAML configuration with errors that name the file, the key and what was expected.
+// Every key a process knows must be present (the shipped config/dlslot.yaml has them all), and
+// a key nobody reads is an error too, so a typo never silently falls back to a default.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <memory>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace dlslot {
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class ConfigSection {
+ public:
+  ConfigSection(YAML::Node node, std::string file, std::string path);
+
+  // Required key of type T (bool, int, double, std::string, std::vector<double>, std::vector<std::string>).
+  template <class T>
+  void get(const std::string& key, T& out);
+  template <class T>
+  T get(const std::string& key) {
+    T v{};
+    get(key, v);
+    return v;
+  }
+  bool has(const std::string& key) const;
+  ConfigSection section(const std::string& key);
+  // Throws ConfigError for every key of this section that was never read.
+  void finish() const;
+  // Marks a key read without reading it (for sections another process owns).
+  void skip(const std::string& key);
+
+  const std::string& file() const { return file_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  YAML::Node child(const std::string& key, const char* expected);
+  std::string where(const std::string& key) const;
+
+  YAML::Node node_;
+  std::string file_, path_;
+  std::shared_ptr<std::set<std::string>> read_;
+};
+
+// Loads a YAML file; throws ConfigError naming the file when it is missing or not YAML.
+ConfigSection loadConfig(const std::string& file);
+
+// Channel names, one place (config section `channels`).
+struct Channels {
+  std::string scan = "LIDAR_SCAN";
+  std::string detections = "DETECTIONS";
+  std::string ground_truth = "GROUND_TRUTH";
+  std::string odometry = "ODOMETRY";
+  std::string associations = "ASSOCIATIONS";
+  std::string slot_state = "SLOT_STATE";
+  std::string status = "PROCESS_STATUS";
+  void read(ConfigSection section);
+};
+
+}  // namespace dlslot

@@ -1,0 +1,109 @@
+// Reading and writing the KITTI tracking and odometry formats (design brief section 3-4).
+// Every reader throws InputError naming the file, the line and what was expected.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dlslot/types.hpp"
+
+namespace dlslot::kitti {
+
+// Calibration of one sequence. Accepts both key spellings (R_rect / R0_rect, Tr_velo_cam /
+// Tr_velo_to_cam, Tr_imu_velo / Tr_imu_to_velo), with or without a colon.
+struct Calib {
+  Eigen::Matrix3d R_rect = Eigen::Matrix3d::Identity();
+  Pose T_cam_velo = Pose::Identity();              // Tr_velo_cam: velodyne -> camera 0
+  std::optional<Pose> T_velo_imu;                  // Tr_imu_velo: imu -> velodyne
+  std::array<Eigen::Matrix<double, 3, 4>, 4> P{};  // P0..P3 (zero when absent)
+
+  // Rectified camera frame <- velodyne: p_rect = R_rect * T_cam_velo * p_velo.
+  Pose T_rect_velo() const;
+};
+Calib readCalib(const std::string& path);
+void writeCalib(const std::string& path, const Calib& calib);  // KITTI tracking spelling, no colon
+
+// One velodyne scan (.bin: float32 x y z reflectance). Throws on a size that is not a multiple
+// of 16 bytes and on NaN or infinite values.
+PointCloud readVelodyne(const std::string& path);
+void writeVelodyne(const std::string& path, const PointCloud& scan);
+
+// A box as KITTI writes it: rectified camera frame, bottom centre, (h, w, l), rotation_y.
+struct CameraBox {
+  double h = 0, w = 0, l = 0;
+  Eigen::Vector3d bottom_center = Eigen::Vector3d::Zero();
+  double rotation_y = 0;
+};
+// p_velo = inv(T_rect_velo) * p_rect, z += h/2, yaw = -(rotation_y + pi/2), (h,w,l) -> (l,w,h).
+Box cameraToLidar(const CameraBox& cam, const Calib& calib);
+CameraBox lidarToCamera(const Box& box, const Calib& calib);
+
+// One row of label_02/SSSS.txt, or of a detection file in the tracking format (+ score column).
+struct LabelRow {
+  int frame = 0;
+  int track_id = -1;
+  std::string type;
+  double truncated = 0;
+  int occluded = 0;
+  double alpha = 0;
+  Eigen::Vector4d bbox2d = Eigen::Vector4d::Zero();  // left top right bottom, pixels
+  CameraBox box;
+  std::optional<double> score;
+};
+std::vector<LabelRow> readTrackingLabels(const std::string& path);  // 17 or 18 fields a line
+void writeTrackingLabels(const std::string& path, const std::vector<LabelRow>& rows);
+
+// The comma-separated detection format: frame,type,x1,y1,x2,y2,score,h,w,l,x,y,z,rot_y,alpha
+// with type 1 Pedestrian, 2 Car, 3 Cyclist.
+std::vector<LabelRow> readCsvDetections(const std::string& path);
+
+// Groups rows by frame, converted to the lidar frame. DontCare rows go to `dontcare` when given
+// (else dropped); rows with score < min_score are dropped (rows without score are kept).
+struct FrameBoxes {
+  std::vector<Box> boxes;
+  std::vector<Box> dontcare;
+};
+std::vector<FrameBoxes> boxesByFrame(const std::vector<LabelRow>& rows, const Calib& calib, int num_frames,
+                                     double min_score = -1e300);
+
+// One oxts line: 30 numbers (lat lon alt roll pitch yaw vn ve vf vl vu ax ay az af al au wx wy wz
+// wf wl wu posacc velacc navstat numsats posmode velmode orimode).
+using OxtsRecord = std::array<double, 30>;
+std::vector<OxtsRecord> readOxts(const std::string& path);
+void writeOxts(const std::string& path, const std::vector<OxtsRecord>& rows);
+// Ego lidar poses T_world_lidar from oxts (Mercator with scale cos(lat0), T_w_imu = [Rz Ry Rx | t],
+// T_w_velo = T_w_imu * inv(T_velo_imu)), re-based so the first frame is the identity.
+std::vector<Pose> oxtsToLidarPoses(const std::vector<OxtsRecord>& rows, const Pose& T_velo_imu);
+// The inverse for the simulator: oxts records (lat, lon, alt, roll, pitch, yaw; other fields 0)
+// whose oxtsToLidarPoses() gives back `poses`, for a chosen origin latitude/longitude.
+std::vector<OxtsRecord> lidarPosesToOxts(const std::vector<Pose>& poses, const Pose& T_velo_imu,
+                                         double lat0_deg, double lon0_deg, double alt0);
+
+// KITTI 3x4 row-major pose files (one pose a line), and KITTI odometry times.txt (seconds).
+std::vector<Pose> readPoses(const std::string& path);
+void writePoses(const std::string& path, const std::vector<Pose>& poses);
+std::vector<double> readTimes(const std::string& path);
+
+// Where a sequence's files are. `root` is a KITTI tracking root (holding training/) or an
+// odometry root (holding sequences/); which one is detected from what exists.
+struct SequencePaths {
+  enum class Layout { Tracking, Odometry } layout = Layout::Tracking;
+  std::string velodyne_dir;
+  std::string calib;            // calib file
+  std::string labels;           // label_02 file ("" when absent)
+  std::string oxts;             // "" when absent
+  std::string poses;            // "" when absent
+  bool poses_are_lidar = false; // tracking layout training/poses/SSSS.txt (simulator): T_world_lidar;
+                                // odometry layout poses/XX.txt: T_world_cam0 (converted with the calib)
+  std::string times;            // odometry times.txt ("" when absent)
+  int num_frames = 0;           // number of .bin files (must be 000000..N-1)
+};
+SequencePaths locateSequence(const std::string& root, const std::string& sequence);
+
+// The class-compatibility rule of the KITTI tracking devkit: Car matches Van, Pedestrian
+// matches Person_sitting; else the names must be equal.
+bool classesCompatible(const std::string& a, const std::string& b);
+
+}  // namespace dlslot::kitti

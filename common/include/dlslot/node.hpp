@@ -1,0 +1,162 @@
+// What every DL-SLOT process shares: command line, config, an event loop on the LCM file
+// descriptor with timers, clean exit on SIGINT/SIGTERM, PROCESS_STATUS at 1 Hz, and typed
+// publish/subscribe helpers that count (never crash on) messages they cannot decode.
+#pragma once
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dlslot/config.hpp"
+#include "dlslot/process_status_t.hpp"
+#include "dlslot/timing_stats.hpp"
+
+namespace dlslot {
+
+// A small option parser: --name VALUE options, --flag switches, --help.
+class CommandLine {
+ public:
+  CommandLine(std::string program, std::string summary);
+  void option(const std::string& name, std::string* value, const std::string& help);
+  void option(const std::string& name, double* value, const std::string& help);
+  void option(const std::string& name, int* value, const std::string& help);
+  void repeated(const std::string& name, std::vector<std::string>* values, const std::string& help);
+  void flag(const std::string& name, bool* value, const std::string& help);
+  // Parses argv. Prints usage and returns false for --help; throws std::invalid_argument with a
+  // clear message for an unknown option or a bad value.
+  bool parse(int argc, char** argv);
+  std::string usage() const;
+
+ private:
+  struct Opt {
+    std::string name, help;
+    std::function<void(const std::string&)> set;
+    bool is_flag = false;
+  };
+  std::string program_, summary_;
+  std::vector<Opt> opts_;
+};
+
+// The options every process takes: --config FILE, --lcm-url URL, --check-config.
+struct NodeOptions {
+  std::string config = "config/dlslot.yaml";
+  std::string lcm_url;  // empty: $LCM_DEFAULT_URL or LCM's default
+  bool check_config = false;
+  void addTo(CommandLine& cl);
+};
+
+// Counters and timing a process reports in PROCESS_STATUS.
+class ProcessStatus {
+ public:
+  explicit ProcessStatus(std::string name);
+  void frameDone(int frame, double ms);  // one frame handled in `ms` milliseconds
+  void decodeError(const std::string& channel);
+  void frameGap(const std::string& channel, int expected, int got);
+  void timeout(const std::string& what);
+  void error(const std::string& what);
+  void warn(const std::string& what);  // logged to stderr and kept as last_warning
+  void count(const std::string& counter, int64_t by = 1);
+  int64_t counter(const std::string& counter) const;
+  int64_t framesHandled() const { return frames_; }
+  process_status_t toMessage() const;
+
+ private:
+  std::string name_;
+  int64_t frames_ = 0;
+  int last_frame_ = -1;
+  TimingStats times_;
+  int64_t decode_errors_ = 0, gaps_ = 0, timeouts_ = 0, errors_ = 0;
+  std::string last_warning_;
+  std::map<std::string, int64_t> counters_;
+};
+
+class Node {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  // Throws std::runtime_error naming the URL when LCM cannot be initialised.
+  Node(std::string name, const std::string& lcm_url, const Channels& channels = Channels());
+
+  lcm::LCM& lcm() { return lcm_; }
+  ProcessStatus& status() { return status_; }
+  const std::string& name() const { return name_; }
+
+  // Decodes and calls `cb`; a message that does not decode is counted and logged, never thrown.
+  template <class Msg>
+  void subscribe(const std::string& channel, std::function<void(const Msg&)> cb);
+  // Same, for frame-indexed messages (a `frame` field): a jump in the frame index is a gap.
+  template <class Msg>
+  void subscribeFrames(const std::string& channel, std::function<void(const Msg&)> cb);
+  template <class Msg>
+  void publish(const std::string& channel, const Msg& msg) {
+    if (lcm_.publish(channel, &msg) != 0) status_.error("publish on " + channel + " failed");
+  }
+
+  // Calls cb every period_s seconds from the loop.
+  void every(double period_s, std::function<void()> cb);
+  // Calls cb once, after delay_s seconds.
+  void after(double delay_s, std::function<void()> cb);
+
+  // Handles messages and timers until SIGINT/SIGTERM or stop(). Publishes PROCESS_STATUS every
+  // second and once more on exit. Returns the process exit code (0).
+  int run();
+  // Handles messages until pred() is true or timeout_s passes; returns pred(). For tests/tools.
+  bool spinUntil(const std::function<bool()>& pred, double timeout_s);
+  void stop() { stop_ = true; }
+  void publishStatus();
+
+ private:
+  void handleOnce(double max_wait_s);
+  struct Timer {
+    Clock::time_point next;
+    double period_s;  // 0 = one-shot
+    std::function<void()> cb;
+  };
+  std::string name_;
+  lcm::LCM lcm_;
+  Channels channels_;
+  ProcessStatus status_;
+  std::vector<Timer> timers_;
+  std::map<std::string, int> last_frame_;
+  bool stop_ = false;
+};
+
+// Installs SIGINT/SIGTERM handlers that make every Node::run() return.
+void installSignalHandlers();
+bool signalReceived();
+
+// Runs `body` and turns any exception into a message on stderr and exit code 1 (2 for a bad
+// command line / config), so every main() reports bad input the same way.
+int runMain(const std::string& program, const std::function<int()>& body);
+
+// ---- template implementations ----
+template <class Msg>
+void Node::subscribe(const std::string& channel, std::function<void(const Msg&)> cb) {
+  lcm_.subscribe(channel,
+                 [this, cb, channel](const lcm::ReceiveBuffer* rbuf, const std::string&) {
+                   Msg msg;
+                   if (msg.decode(rbuf->data, 0, rbuf->data_size) < 0) {
+                     status_.decodeError(channel);
+                     return;
+                   }
+                   cb(msg);
+                 });
+}
+
+template <class Msg>
+void Node::subscribeFrames(const std::string& channel, std::function<void(const Msg&)> cb) {
+  subscribe<Msg>(channel, [this, cb, channel](const Msg& msg) {
+    auto it = last_frame_.find(channel);
+    if (it != last_frame_.end() && msg.frame > it->second + 1)
+      status_.frameGap(channel, it->second + 1, msg.frame);
+    last_frame_[channel] = msg.frame;
+    cb(msg);
+  });
+}
+
+}  // namespace dlslot

@@ -1,0 +1,20 @@
+// Mean / p95 / max of per-frame processing times.
+#pragma once
+
+#include <vector>
+
+namespace dlslot {
+
+class TimingStats {
+ public:
+  void add(double ms) { samples_.push_back(ms); }
+  size_t count() const { return samples_.size(); }
+  double mean() const;
+  double percentile(double p) const;  // p in [0, 100]; 0 when empty
+  double max() const;
+
+ private:
+  std::vector<double> samples_;
+};
+
+}  // namespace dlslot

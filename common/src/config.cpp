@@ -1,0 +1,103 @@
+#include "dlslot/config.hpp"
+
+#include <fstream>
+
+namespace dlslot {
+namespace {
+
+template <class T>
+const char* typeName();
+template <> const char* typeName<bool>() { return "true or false"; }
+template <> const char* typeName<int>() { return "an integer"; }
+template <> const char* typeName<double>() { return "a number"; }
+template <> const char* typeName<std::string>() { return "a string"; }
+template <> const char* typeName<std::vector<double>>() { return "a list of numbers"; }
+template <> const char* typeName<std::vector<std::string>>() { return "a list of strings"; }
+
+}  // namespace
+
+ConfigSection::ConfigSection(YAML::Node node, std::string file, std::string path)
+    : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)),
+      read_(std::make_shared<std::set<std::string>>()) {}
+
+std::string ConfigSection::where(const std::string& key) const {
+  std::string full = path_.empty() ? key : path_ + "." + key;
+  return file_ + ": " + full;
+}
+
+bool ConfigSection::has(const std::string& key) const { return node_.IsMap() && node_[key]; }
+
+YAML::Node ConfigSection::child(const std::string& key, const char* expected) {
+  if (!node_.IsMap() || !node_[key])
+    throw ConfigError(where(key) + ": missing (expected " + expected + ")");
+  read_->insert(key);
+  return node_[key];
+}
+
+template <class T>
+void ConfigSection::get(const std::string& key, T& out) {
+  YAML::Node n = child(key, typeName<T>());
+  try {
+    if constexpr (std::is_same_v<T, std::string>) {
+      if (!n.IsScalar()) throw YAML::Exception(n.Mark(), "");
+    } else if constexpr (std::is_same_v<T, std::vector<double>> || std::is_same_v<T, std::vector<std::string>>) {
+      if (!n.IsSequence()) throw YAML::Exception(n.Mark(), "");
+    }
+    out = n.as<T>();
+  } catch (const YAML::Exception&) {
+    std::string got = n.IsScalar() ? "'" + n.Scalar() + "'" : n.IsSequence() ? "a list" : "a map";
+    throw ConfigError(where(key) + " (line " + std::to_string(n.Mark().line + 1) + "): expected " +
+                      typeName<T>() + ", got " + got);
+  }
+}
+
+template void ConfigSection::get<bool>(const std::string&, bool&);
+template void ConfigSection::get<int>(const std::string&, int&);
+template void ConfigSection::get<double>(const std::string&, double&);
+template void ConfigSection::get<std::string>(const std::string&, std::string&);
+template void ConfigSection::get<std::vector<double>>(const std::string&, std::vector<double>&);
+template void ConfigSection::get<std::vector<std::string>>(const std::string&, std::vector<std::string>&);
+
+ConfigSection ConfigSection::section(const std::string& key) {
+  YAML::Node n = child(key, "a map");
+  if (!n.IsMap())
+    throw ConfigError(where(key) + " (line " + std::to_string(n.Mark().line + 1) + "): expected a map");
+  return ConfigSection(n, file_, path_.empty() ? key : path_ + "." + key);
+}
+
+void ConfigSection::skip(const std::string& key) { read_->insert(key); }
+
+void ConfigSection::finish() const {
+  if (!node_.IsMap()) return;
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.as<std::string>();
+    if (!read_->count(key))
+      throw ConfigError(where(key) + " (line " + std::to_string(kv.first.Mark().line + 1) +
+                        "): unknown key");
+  }
+}
+
+ConfigSection loadConfig(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw ConfigError(file + ": cannot open config file");
+  try {
+    YAML::Node root = YAML::Load(in);
+    if (!root.IsMap()) throw ConfigError(file + ": expected a YAML map at the top level");
+    return ConfigSection(root, file, "");
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(file + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
+  }
+}
+
+void Channels::read(ConfigSection s) {
+  s.get("scan", scan);
+  s.get("detections", detections);
+  s.get("ground_truth", ground_truth);
+  s.get("odometry", odometry);
+  s.get("associations", associations);
+  s.get("slot_state", slot_state);
+  s.get("status", status);
+  s.finish();
+}
+
+}  // namespace dlslot

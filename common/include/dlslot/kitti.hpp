@@ -107,3 +107,33 @@ SequencePaths locateSequence(const std::string& root, const std::string& sequenc
 bool classesCompatible(const std::string& a, const std::string& b);
 
 }  // namespace dlslot::kitti
+
+namespace dlslot::kitti {
+
+// Reads a whole sequence frame by frame: scans, detections (lidar frame), labels, ground-truth
+// ego poses. The player, the offline tools and tests all read data through this one class.
+class SequenceReader {
+ public:
+  // detection_paths: files in the tracking format (+score) or the comma-separated per-class
+  // format, or directories holding SSSS.txt; the format is detected from the content.
+  SequenceReader(const std::string& root, const std::string& sequence,
+                 const std::vector<std::string>& detection_paths = {}, double min_detection_score = -1e300,
+                 double frame_period_s = 0.1);
+  int size() const { return paths_.num_frames; }
+  const SequencePaths& paths() const { return paths_; }
+  const Calib& calib() const { return calib_; }
+  bool hasGroundTruthPoses() const { return !gt_poses_.empty(); }
+  bool hasLabels() const { return !labels_.empty(); }
+  const std::vector<Pose>& groundTruthPoses() const { return gt_poses_; }
+  Frame read(int index) const;  // throws InputError for a bad .bin
+
+ private:
+  SequencePaths paths_;
+  Calib calib_;
+  std::vector<Pose> gt_poses_;
+  std::vector<FrameBoxes> labels_, detections_;
+  std::vector<double> times_;
+  double frame_period_s_;
+};
+
+}  // namespace dlslot::kitti

@@ -1,6 +1,7 @@
 // Mean / p95 / max of per-frame processing times.
 #pragma once
 
+#include <cstddef>
 #include <vector>
 
 namespace dlslot {

@@ -1,0 +1,540 @@
+#include "dlslot/kitti.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "dlslot/input_error.hpp"
+
+namespace fs = std::filesystem;
+
+namespace dlslot::kitti {
+namespace {
+
+constexpr double kEarthRadius = 6378137.0;  // the KITTI devkit's Mercator radius
+
+std::vector<std::string> splitWs(const std::string& line) {
+  std::istringstream is(line);
+  std::vector<std::string> out;
+  for (std::string t; is >> t;) out.push_back(t);
+  return out;
+}
+
+std::vector<std::string> splitComma(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : line) {
+    if (c == ',') {
+      out.push_back(cur);
+      cur.clear();
+    } else if (c != '\r' && c != ' ') {
+      cur += c;
+    }
+  }
+  out.push_back(cur);
+  return out;
+}
+
+double number(const std::string& tok, const std::string& file, int line, const std::string& field) {
+  size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(tok, &used);
+  } catch (...) {
+    used = 0;
+  }
+  if (used != tok.size() || tok.empty())
+    throw InputError(file, line, field + ": expected a number, got '" + tok + "'");
+  return v;
+}
+
+int integer(const std::string& tok, const std::string& file, int line, const std::string& field) {
+  const double v = number(tok, file, line, field);
+  if (v != std::floor(v)) throw InputError(file, line, field + ": expected an integer, got '" + tok + "'");
+  return static_cast<int>(v);
+}
+
+std::ifstream openText(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, 0, "cannot open file");
+  return in;
+}
+
+Pose rowsToPose(const std::vector<double>& v) {  // 12 numbers, 3x4 row-major
+  Pose T = Pose::Identity();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) T.matrix()(r, c) = v[r * 4 + c];
+  return T;
+}
+
+void writeRows(std::FILE* f, const Eigen::MatrixXd& m) {
+  for (int r = 0; r < m.rows(); ++r)
+    for (int c = 0; c < m.cols(); ++c) std::fprintf(f, " %.12e", m(r, c));
+}
+
+std::FILE* openWrite(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) throw InputError(path, 0, "cannot open file for writing");
+  return f;
+}
+
+Eigen::Matrix3d rpyToR(double roll, double pitch, double yaw) {
+  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+}  // namespace
+
+// ---------------- calib ----------------
+
+Pose Calib::T_rect_velo() const {
+  Pose R = Pose::Identity();
+  R.linear() = R_rect;
+  return R * T_cam_velo;
+}
+
+Calib readCalib(const std::string& path) {
+  std::ifstream in = openText(path);
+  Calib calib;
+  bool have_velo_cam = false;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    std::vector<std::string> tok = splitWs(line);
+    if (tok.empty()) continue;
+    std::string key = tok[0];
+    if (!key.empty() && key.back() == ':') key.pop_back();
+    std::vector<double> v;
+    for (size_t i = 1; i < tok.size(); ++i) v.push_back(number(tok[i], path, n, key));
+    auto need = [&](size_t count) {
+      if (v.size() != count)
+        throw InputError(path, n, key + ": expected " + std::to_string(count) + " numbers, got " +
+                                      std::to_string(v.size()));
+    };
+    if (key == "R_rect" || key == "R0_rect") {
+      need(9);
+      for (int i = 0; i < 9; ++i) calib.R_rect(i / 3, i % 3) = v[i];
+    } else if (key == "Tr_velo_cam" || key == "Tr_velo_to_cam" || key == "Tr") {
+      need(12);
+      calib.T_cam_velo = rowsToPose(v);
+      have_velo_cam = true;
+    } else if (key == "Tr_imu_velo" || key == "Tr_imu_to_velo") {
+      need(12);
+      calib.T_velo_imu = rowsToPose(v);
+    } else if (key.size() == 2 && key[0] == 'P' && key[1] >= '0' && key[1] <= '3') {
+      need(12);
+      for (int i = 0; i < 12; ++i) calib.P[key[1] - '0'](i / 4, i % 4) = v[i];
+    }
+  }
+  if (!have_velo_cam)
+    throw InputError(path, 0, "no velodyne-to-camera transform (expected a Tr_velo_cam, Tr_velo_to_cam or Tr line)");
+  return calib;
+}
+
+void writeCalib(const std::string& path, const Calib& calib) {
+  std::FILE* f = openWrite(path);
+  for (int i = 0; i < 4; ++i) {
+    std::fprintf(f, "P%d", i);
+    writeRows(f, calib.P[i]);
+    std::fprintf(f, "\n");
+  }
+  std::fprintf(f, "R_rect");
+  writeRows(f, calib.R_rect);
+  std::fprintf(f, "\nTr_velo_cam");
+  writeRows(f, calib.T_cam_velo.matrix().topRows<3>());
+  std::fprintf(f, "\n");
+  if (calib.T_velo_imu) {
+    std::fprintf(f, "Tr_imu_velo");
+    writeRows(f, calib.T_velo_imu->matrix().topRows<3>());
+    std::fprintf(f, "\n");
+  }
+  std::fclose(f);
+}
+
+// ---------------- velodyne ----------------
+
+PointCloud readVelodyne(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) throw InputError(path, 0, "cannot open velodyne scan");
+  const std::streamsize bytes = in.tellg();
+  if (bytes % 16 != 0)
+    throw InputError(path, 0, "size " + std::to_string(bytes) +
+                                  " bytes is not a multiple of 16 (expected float32 x y z reflectance per point)");
+  PointCloud scan(4, bytes / 16);
+  in.seekg(0);
+  in.read(reinterpret_cast<char*>(scan.data()), bytes);
+  if (!in) throw InputError(path, 0, "short read");
+  if (!scan.allFinite()) {
+    for (Eigen::Index i = 0; i < scan.cols(); ++i)
+      if (!scan.col(i).allFinite())
+        throw InputError(path, 0, "point " + std::to_string(i) + " has a NaN or infinite value");
+  }
+  return scan;
+}
+
+void writeVelodyne(const std::string& path, const PointCloud& scan) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw InputError(path, 0, "cannot open file for writing");
+  out.write(reinterpret_cast<const char*>(scan.data()), scan.size() * sizeof(float));
+}
+
+// ---------------- boxes ----------------
+
+Box cameraToLidar(const CameraBox& cam, const Calib& calib) {
+  Box b;
+  b.center = calib.T_rect_velo().inverse() * cam.bottom_center;
+  b.center.z() += 0.5 * cam.h;  // KITTI gives the bottom centre; the lidar z axis is up
+  b.size = Eigen::Vector3d(cam.l, cam.w, cam.h);
+  b.yaw = wrapAngle(-(cam.rotation_y + M_PI / 2));
+  return b;
+}
+
+CameraBox lidarToCamera(const Box& box, const Calib& calib) {
+  CameraBox cam;
+  cam.l = box.size.x();
+  cam.w = box.size.y();
+  cam.h = box.size.z();
+  cam.bottom_center = calib.T_rect_velo() * (box.center - Eigen::Vector3d(0, 0, 0.5 * cam.h));
+  cam.rotation_y = wrapAngle(-box.yaw - M_PI / 2);
+  return cam;
+}
+
+// ---------------- labels and detections ----------------
+
+std::vector<LabelRow> readTrackingLabels(const std::string& path) {
+  std::ifstream in = openText(path);
+  std::vector<LabelRow> rows;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    std::vector<std::string> t = splitWs(line);
+    if (t.empty()) continue;
+    if (t.size() != 17 && t.size() != 18)
+      throw InputError(path, n, "expected 17 fields (frame id type truncated occluded alpha x1 y1 x2 y2 h w l x y z "
+                                "rotation_y) or 18 (+ score), got " + std::to_string(t.size()));
+    LabelRow r;
+    r.frame = integer(t[0], path, n, "frame");
+    if (r.frame < 0) throw InputError(path, n, "frame: expected >= 0, got " + t[0]);
+    r.track_id = integer(t[1], path, n, "track id");
+    r.type = t[2];
+    r.truncated = number(t[3], path, n, "truncated");
+    r.occluded = integer(t[4], path, n, "occluded");
+    r.alpha = number(t[5], path, n, "alpha");
+    for (int i = 0; i < 4; ++i) r.bbox2d[i] = number(t[6 + i], path, n, "bbox");
+    r.box.h = number(t[10], path, n, "h");
+    r.box.w = number(t[11], path, n, "w");
+    r.box.l = number(t[12], path, n, "l");
+    for (int i = 0; i < 3; ++i) r.box.bottom_center[i] = number(t[13 + i], path, n, "location");
+    r.box.rotation_y = number(t[16], path, n, "rotation_y");
+    if (t.size() == 18) r.score = number(t[17], path, n, "score");
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+void writeTrackingLabels(const std::string& path, const std::vector<LabelRow>& rows) {
+  std::FILE* f = openWrite(path);
+  for (const LabelRow& r : rows) {
+    std::fprintf(f, "%d %d %s %.6f %d %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f", r.frame,
+                 r.track_id, r.type.c_str(), r.truncated, r.occluded, r.alpha, r.bbox2d[0], r.bbox2d[1],
+                 r.bbox2d[2], r.bbox2d[3], r.box.h, r.box.w, r.box.l, r.box.bottom_center.x(),
+                 r.box.bottom_center.y(), r.box.bottom_center.z(), r.box.rotation_y);
+    if (r.score) std::fprintf(f, " %.6f", *r.score);
+    std::fprintf(f, "\n");
+  }
+  std::fclose(f);
+}
+
+std::vector<LabelRow> readCsvDetections(const std::string& path) {
+  std::ifstream in = openText(path);
+  std::vector<LabelRow> rows;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::vector<std::string> t = splitComma(line);
+    if (t.size() != 15)
+      throw InputError(path, n, "expected 15 comma-separated fields (frame,type,x1,y1,x2,y2,score,h,w,l,x,y,z,rot_y,"
+                                "alpha), got " + std::to_string(t.size()));
+    LabelRow r;
+    r.frame = integer(t[0], path, n, "frame");
+    if (r.frame < 0) throw InputError(path, n, "frame: expected >= 0, got " + t[0]);
+    const int type = integer(t[1], path, n, "type");
+    static const std::map<int, std::string> kTypes = {{1, "Pedestrian"}, {2, "Car"}, {3, "Cyclist"}};
+    auto it = kTypes.find(type);
+    if (it == kTypes.end()) throw InputError(path, n, "type: expected 1 (Pedestrian), 2 (Car) or 3 (Cyclist), got " + t[1]);
+    r.type = it->second;
+    for (int i = 0; i < 4; ++i) r.bbox2d[i] = number(t[2 + i], path, n, "bbox");
+    r.score = number(t[6], path, n, "score");
+    r.box.h = number(t[7], path, n, "h");
+    r.box.w = number(t[8], path, n, "w");
+    r.box.l = number(t[9], path, n, "l");
+    for (int i = 0; i < 3; ++i) r.box.bottom_center[i] = number(t[10 + i], path, n, "location");
+    r.box.rotation_y = number(t[13], path, n, "rot_y");
+    r.alpha = number(t[14], path, n, "alpha");
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+std::vector<FrameBoxes> boxesByFrame(const std::vector<LabelRow>& rows, const Calib& calib, int num_frames,
+                                     double min_score) {
+  std::vector<FrameBoxes> out(num_frames);
+  for (const LabelRow& r : rows) {
+    if (r.frame >= num_frames) continue;  // rows for frames this sequence (slice) does not have
+    if (r.score && *r.score < min_score) continue;
+    Box b = cameraToLidar(r.box, calib);
+    b.type = r.type;
+    b.id = r.track_id;
+    b.score = r.score.value_or(1.0);
+    if (r.type == "DontCare") {
+      // Real KITTI DontCare rows have no 3D box (-1 sizes); keep them only when they have one.
+      if (r.box.h > 0 && r.box.w > 0 && r.box.l > 0) out[r.frame].dontcare.push_back(b);
+    } else {
+      out[r.frame].boxes.push_back(b);
+    }
+  }
+  return out;
+}
+
+// ---------------- oxts ----------------
+
+std::vector<OxtsRecord> readOxts(const std::string& path) {
+  std::ifstream in = openText(path);
+  std::vector<OxtsRecord> rows;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    std::vector<std::string> t = splitWs(line);
+    if (t.empty()) continue;
+    if (t.size() != 30)
+      throw InputError(path, n, "expected 30 oxts fields (lat lon alt roll pitch yaw ... orimode), got " +
+                                    std::to_string(t.size()));
+    OxtsRecord r;
+    for (int i = 0; i < 30; ++i) r[i] = number(t[i], path, n, "field " + std::to_string(i + 1));
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+void writeOxts(const std::string& path, const std::vector<OxtsRecord>& rows) {
+  std::FILE* f = openWrite(path);
+  for (const OxtsRecord& r : rows) {
+    // lat/lon need ~1e-11 degrees to keep the round trip within a micrometre.
+    for (int i = 0; i < 30; ++i) std::fprintf(f, i < 25 ? "%s%.14g" : "%s%.0f", i ? " " : "", r[i]);
+    std::fprintf(f, "\n");
+  }
+  std::fclose(f);
+}
+
+std::vector<Pose> oxtsToLidarPoses(const std::vector<OxtsRecord>& rows, const Pose& T_velo_imu) {
+  std::vector<Pose> poses;
+  if (rows.empty()) return poses;
+  const double scale = std::cos(rows[0][0] * M_PI / 180.0);
+  const Pose T_imu_velo = T_velo_imu.inverse();
+  Pose T0_inv = Pose::Identity();
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const OxtsRecord& r = rows[i];
+    Pose T_w_imu = Pose::Identity();
+    T_w_imu.translation() << scale * r[1] * M_PI * kEarthRadius / 180.0,
+        scale * kEarthRadius * std::log(std::tan((90.0 + r[0]) * M_PI / 360.0)), r[2];
+    T_w_imu.linear() = rpyToR(r[3], r[4], r[5]);
+    const Pose T_w_velo = T_w_imu * T_imu_velo;
+    if (i == 0) T0_inv = T_w_velo.inverse();
+    poses.push_back(T0_inv * T_w_velo);
+  }
+  return poses;
+}
+
+std::vector<OxtsRecord> lidarPosesToOxts(const std::vector<Pose>& poses, const Pose& T_velo_imu, double lat0_deg,
+                                         double lon0_deg, double alt0) {
+  const double scale = std::cos(lat0_deg * M_PI / 180.0);
+  // Place the first IMU position exactly at (lat0, lon0, alt0) so the scale the reader derives from
+  // the first record is the one used here.
+  const Eigen::Vector3d imu0(scale * lon0_deg * M_PI * kEarthRadius / 180.0,
+                             scale * kEarthRadius * std::log(std::tan((90.0 + lat0_deg) * M_PI / 360.0)), alt0);
+  Pose A = Pose::Identity();
+  A.translation() = imu0 - (poses.empty() ? Pose::Identity() : poses[0]) * T_velo_imu.translation();
+  std::vector<OxtsRecord> rows;
+  for (const Pose& P : poses) {
+    const Pose T_w_imu = A * P * T_velo_imu;
+    const Eigen::Matrix3d R = T_w_imu.linear();
+    OxtsRecord r{};
+    const Eigen::Vector3d t = T_w_imu.translation();
+    r[0] = 360.0 / M_PI * std::atan(std::exp(t.y() / (scale * kEarthRadius))) - 90.0;
+    r[1] = t.x() * 180.0 / (scale * M_PI * kEarthRadius);
+    r[2] = t.z();
+    // R = Rz(yaw) Ry(pitch) Rx(roll)
+    r[4] = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+    r[3] = std::atan2(R(2, 1), R(2, 2));
+    r[5] = std::atan2(R(1, 0), R(0, 0));
+    r[25] = 4;  // navstat: RTK fix
+    r[26] = 10; // numsats
+    r[27] = r[28] = r[29] = 4;
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+// ---------------- poses and times ----------------
+
+std::vector<Pose> readPoses(const std::string& path) {
+  std::ifstream in = openText(path);
+  std::vector<Pose> poses;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    std::vector<std::string> t = splitWs(line);
+    if (t.empty()) continue;
+    if (t.size() != 12)
+      throw InputError(path, n, "expected 12 numbers (a 3x4 row-major pose), got " + std::to_string(t.size()));
+    std::vector<double> v;
+    for (const auto& s : t) v.push_back(number(s, path, n, "pose"));
+    poses.push_back(rowsToPose(v));
+  }
+  return poses;
+}
+
+void writePoses(const std::string& path, const std::vector<Pose>& poses) {
+  std::FILE* f = openWrite(path);
+  for (const Pose& T : poses) {
+    const Eigen::Matrix<double, 3, 4> m = T.matrix().topRows<3>();
+    for (int i = 0; i < 12; ++i) std::fprintf(f, i ? " %.12e" : "%.12e", m(i / 4, i % 4));
+    std::fprintf(f, "\n");
+  }
+  std::fclose(f);
+}
+
+std::vector<double> readTimes(const std::string& path) {
+  std::ifstream in = openText(path);
+  std::vector<double> times;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    std::vector<std::string> t = splitWs(line);
+    if (t.empty()) continue;
+    if (t.size() != 1) throw InputError(path, n, "expected one time in seconds, got " + std::to_string(t.size()) + " fields");
+    times.push_back(number(t[0], path, n, "time"));
+  }
+  return times;
+}
+
+// ---------------- sequences ----------------
+
+SequencePaths locateSequence(const std::string& root, const std::string& sequence) {
+  if (!fs::is_directory(root)) throw InputError(root, 0, "data set root is not a directory");
+  SequencePaths p;
+  auto ifExists = [](const fs::path& f) { return fs::exists(f) ? f.string() : std::string(); };
+  fs::path tracking = fs::path(root) / "training";
+  if (!fs::is_directory(tracking / "velodyne") && fs::is_directory(fs::path(root) / "velodyne")) tracking = root;
+  const fs::path odometry = fs::path(root) / "sequences" / sequence;
+  if (fs::is_directory(tracking / "velodyne" / sequence)) {
+    p.layout = SequencePaths::Layout::Tracking;
+    p.velodyne_dir = (tracking / "velodyne" / sequence).string();
+    p.calib = (tracking / "calib" / (sequence + ".txt")).string();
+    p.labels = ifExists(tracking / "label_02" / (sequence + ".txt"));
+    p.oxts = ifExists(tracking / "oxts" / (sequence + ".txt"));
+    p.poses = ifExists(tracking / "poses" / (sequence + ".txt"));
+    p.poses_are_lidar = true;
+  } else if (fs::is_directory(odometry / "velodyne")) {
+    p.layout = SequencePaths::Layout::Odometry;
+    p.velodyne_dir = (odometry / "velodyne").string();
+    p.calib = (odometry / "calib.txt").string();
+    p.times = ifExists(odometry / "times.txt");
+    p.poses = ifExists(fs::path(root) / "poses" / (sequence + ".txt"));
+    p.poses_are_lidar = false;
+  } else {
+    throw InputError(root, 0, "no sequence '" + sequence + "': expected " + (tracking / "velodyne" / sequence).string() +
+                                  " (KITTI tracking) or " + (odometry / "velodyne").string() + " (KITTI odometry)");
+  }
+  if (!fs::exists(p.calib)) throw InputError(p.calib, 0, "calibration file missing");
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(p.velodyne_dir))
+    if (e.path().extension() == ".bin") ++n;
+  for (int i = 0; i < n; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d.bin", i);
+    if (!fs::exists(fs::path(p.velodyne_dir) / name))
+      throw InputError(p.velodyne_dir, 0, "expected scans 000000.bin .. " + std::to_string(n - 1) +
+                                              ".bin without gaps; missing " + name);
+  }
+  if (n == 0) throw InputError(p.velodyne_dir, 0, "no .bin scans");
+  p.num_frames = n;
+  return p;
+}
+
+bool classesCompatible(const std::string& a, const std::string& b) {
+  auto canon = [](const std::string& s) {
+    if (s == "Van") return std::string("Car");
+    if (s == "Person_sitting") return std::string("Pedestrian");
+    return s;
+  };
+  return canon(a) == canon(b);
+}
+
+// ---------------- SequenceReader ----------------
+
+SequenceReader::SequenceReader(const std::string& root, const std::string& sequence,
+                               const std::vector<std::string>& detection_paths, double min_detection_score,
+                               double frame_period_s)
+    : paths_(locateSequence(root, sequence)), calib_(readCalib(paths_.calib)), frame_period_s_(frame_period_s) {
+  const int n = paths_.num_frames;
+  // Ground-truth ego poses: a poses file wins over oxts.
+  if (!paths_.poses.empty()) {
+    std::vector<Pose> poses = readPoses(paths_.poses);
+    if (!paths_.poses_are_lidar) {
+      const Pose Tr = calib_.T_cam_velo;
+      for (Pose& T : poses) T = Tr.inverse() * T * Tr;
+    }
+    gt_poses_ = std::move(poses);
+  } else if (!paths_.oxts.empty()) {
+    if (!calib_.T_velo_imu)
+      throw InputError(paths_.calib, 0, "oxts poses need the imu-to-velodyne transform (Tr_imu_velo or Tr_imu_to_velo)");
+    gt_poses_ = oxtsToLidarPoses(readOxts(paths_.oxts), *calib_.T_velo_imu);
+  }
+  if (!gt_poses_.empty() && static_cast<int>(gt_poses_.size()) < n)
+    throw InputError(!paths_.poses.empty() ? paths_.poses : paths_.oxts, 0,
+                     "has " + std::to_string(gt_poses_.size()) + " poses, expected one per scan (" + std::to_string(n) + ")");
+  if (!paths_.labels.empty()) labels_ = boxesByFrame(readTrackingLabels(paths_.labels), calib_, n);
+  if (!paths_.times.empty()) {
+    times_ = readTimes(paths_.times);
+    if (static_cast<int>(times_.size()) < n)
+      throw InputError(paths_.times, 0, "has " + std::to_string(times_.size()) + " times, expected " + std::to_string(n));
+  }
+  if (!detection_paths.empty()) detections_.assign(n, {});
+  for (std::string path : detection_paths) {
+    if (fs::is_directory(path)) path = (fs::path(path) / (sequence + ".txt")).string();
+    std::ifstream in = openText(path);
+    std::string first;
+    while (std::getline(in, first) && first.find_first_not_of(" \t\r") == std::string::npos) {
+    }
+    const bool csv = first.find(',') != std::string::npos;
+    const auto rows = csv ? readCsvDetections(path) : readTrackingLabels(path);
+    const auto frames = boxesByFrame(rows, calib_, n, min_detection_score);
+    for (int i = 0; i < n; ++i)
+      detections_[i].boxes.insert(detections_[i].boxes.end(), frames[i].boxes.begin(), frames[i].boxes.end());
+  }
+  // Detector output carries no track ids.
+  for (auto& f : detections_)
+    for (Box& b : f.boxes) b.id = -1;
+}
+
+Frame SequenceReader::read(int index) const {
+  if (index < 0 || index >= paths_.num_frames)
+    throw std::out_of_range("frame " + std::to_string(index) + " outside 0.." + std::to_string(paths_.num_frames - 1));
+  Frame f;
+  f.index = index;
+  const double t = times_.empty() ? index * frame_period_s_ : times_[index];
+  f.utime = static_cast<int64_t>(std::llround(t * 1e6));
+  char name[32];
+  std::snprintf(name, sizeof name, "%06d.bin", index);
+  f.scan = readVelodyne((fs::path(paths_.velodyne_dir) / name).string());
+  if (!detections_.empty()) f.detections = detections_[index].boxes;
+  if (!labels_.empty()) {
+    f.labels = labels_[index].boxes;
+    f.dontcare = labels_[index].dontcare;
+  }
+  if (!gt_poses_.empty()) f.gt_pose = gt_poses_[index];
+  return f;
+}
+
+}  // namespace dlslot::kitti

@@ -1,0 +1,270 @@
+#include "dlslot/node.hpp"
+
+#include <poll.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+
+#include "dlslot/input_error.hpp"
+
+namespace dlslot {
+
+// ---------------- CommandLine ----------------
+
+CommandLine::CommandLine(std::string program, std::string summary)
+    : program_(std::move(program)), summary_(std::move(summary)) {}
+
+void CommandLine::option(const std::string& name, std::string* value, const std::string& help) {
+  opts_.push_back({name, help, [value](const std::string& v) { *value = v; }});
+}
+
+void CommandLine::option(const std::string& name, double* value, const std::string& help) {
+  opts_.push_back({name, help, [name, value](const std::string& v) {
+                     size_t used = 0;
+                     try {
+                       *value = std::stod(v, &used);
+                     } catch (...) {
+                     }
+                     if (used != v.size() || v.empty())
+                       throw std::invalid_argument(name + ": expected a number, got '" + v + "'");
+                   }});
+}
+
+void CommandLine::option(const std::string& name, int* value, const std::string& help) {
+  opts_.push_back({name, help, [name, value](const std::string& v) {
+                     size_t used = 0;
+                     try {
+                       *value = std::stoi(v, &used);
+                     } catch (...) {
+                     }
+                     if (used != v.size() || v.empty())
+                       throw std::invalid_argument(name + ": expected an integer, got '" + v + "'");
+                   }});
+}
+
+void CommandLine::repeated(const std::string& name, std::vector<std::string>* values, const std::string& help) {
+  opts_.push_back({name, help + " (repeatable)", [values](const std::string& v) { values->push_back(v); }});
+}
+
+void CommandLine::flag(const std::string& name, bool* value, const std::string& help) {
+  Opt o{name, help, [value](const std::string&) { *value = true; }};
+  o.is_flag = true;
+  opts_.push_back(o);
+}
+
+std::string CommandLine::usage() const {
+  std::ostringstream os;
+  os << "usage: " << program_ << " [options]\n" << summary_ << "\n\noptions:\n";
+  for (const Opt& o : opts_) {
+    std::string lhs = o.name + (o.is_flag ? "" : " VALUE");
+    os << "  " << lhs << std::string(lhs.size() < 26 ? 26 - lhs.size() : 1, ' ') << o.help << "\n";
+  }
+  os << "  --help                    show this help\n";
+  return os.str();
+}
+
+bool CommandLine::parse(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      std::cout << usage();
+      return false;
+    }
+    std::string value;
+    bool has_inline = false;
+    if (auto eq = arg.find('='); arg.rfind("--", 0) == 0 && eq != std::string::npos) {
+      value = arg.substr(eq + 1);
+      arg = arg.substr(0, eq);
+      has_inline = true;
+    }
+    auto it = std::find_if(opts_.begin(), opts_.end(), [&](const Opt& o) { return o.name == arg; });
+    if (it == opts_.end()) throw std::invalid_argument("unknown option '" + arg + "' (see --help)");
+    if (!it->is_flag && !has_inline) {
+      if (i + 1 >= argc) throw std::invalid_argument(arg + ": missing value");
+      value = argv[++i];
+    }
+    it->set(value);
+  }
+  return true;
+}
+
+void NodeOptions::addTo(CommandLine& cl) {
+  cl.option("--config", &config, "YAML config file (default config/dlslot.yaml)");
+  cl.option("--lcm-url", &lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or LCM's default)");
+  cl.flag("--check-config", &check_config, "load and validate the config, then exit");
+}
+
+// ---------------- ProcessStatus ----------------
+
+ProcessStatus::ProcessStatus(std::string name) : name_(std::move(name)) {}
+
+void ProcessStatus::frameDone(int frame, double ms) {
+  ++frames_;
+  last_frame_ = frame;
+  times_.add(ms);
+}
+
+void ProcessStatus::decodeError(const std::string& channel) {
+  ++decode_errors_;
+  warn("could not decode a message on " + channel + " (skipped)");
+}
+
+void ProcessStatus::frameGap(const std::string& channel, int expected, int got) {
+  gaps_ += got - expected;
+  warn(channel + ": frame gap, expected frame " + std::to_string(expected) + ", got " + std::to_string(got));
+}
+
+void ProcessStatus::timeout(const std::string& what) {
+  ++timeouts_;
+  warn("timeout: " + what);
+}
+
+void ProcessStatus::error(const std::string& what) {
+  ++errors_;
+  warn(what);
+}
+
+void ProcessStatus::warn(const std::string& what) {
+  last_warning_ = what;
+  std::fprintf(stderr, "[%s] %s\n", name_.c_str(), what.c_str());
+}
+
+void ProcessStatus::count(const std::string& counter, int64_t by) { counters_[counter] += by; }
+
+int64_t ProcessStatus::counter(const std::string& counter) const {
+  auto it = counters_.find(counter);
+  return it == counters_.end() ? 0 : it->second;
+}
+
+process_status_t ProcessStatus::toMessage() const {
+  process_status_t m;
+  m.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                std::chrono::system_clock::now().time_since_epoch())
+                .count();
+  m.name = name_;
+  m.pid = getpid();
+  m.frames_handled = frames_;
+  m.last_frame = last_frame_;
+  m.time_mean_ms = times_.mean();
+  m.time_p95_ms = times_.percentile(95);
+  m.time_max_ms = times_.max();
+  m.decode_errors = decode_errors_;
+  m.frame_gaps = gaps_;
+  m.timeouts = timeouts_;
+  m.errors = errors_;
+  m.last_warning = last_warning_;
+  for (const auto& [k, v] : counters_) {
+    m.counter_names.push_back(k);
+    m.counter_values.push_back(v);
+  }
+  m.num_counters = static_cast<int32_t>(m.counter_names.size());
+  return m;
+}
+
+// ---------------- signals ----------------
+
+namespace {
+std::atomic<bool> g_signal{false};
+void onSignal(int) { g_signal = true; }
+}  // namespace
+
+void installSignalHandlers() {
+  struct sigaction sa {};
+  sa.sa_handler = onSignal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+bool signalReceived() { return g_signal; }
+
+// ---------------- Node ----------------
+
+Node::Node(std::string name, const std::string& lcm_url, const Channels& channels)
+    : name_(std::move(name)), lcm_(lcm_url), channels_(channels), status_(name_) {
+  if (!lcm_.good())
+    throw std::runtime_error("cannot initialise LCM with URL '" +
+                             (lcm_url.empty() ? std::string("(default)") : lcm_url) + "'");
+}
+
+void Node::every(double period_s, std::function<void()> cb) {
+  timers_.push_back({Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s)),
+                     period_s, std::move(cb)});
+}
+
+void Node::after(double delay_s, std::function<void()> cb) {
+  timers_.push_back({Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(delay_s)),
+                     0.0, std::move(cb)});
+}
+
+void Node::publishStatus() { publish(channels_.status, status_.toMessage()); }
+
+void Node::handleOnce(double max_wait_s) {
+  // Wait for LCM traffic or the next timer, whichever comes first.
+  auto now = Clock::now();
+  double wait = max_wait_s;
+  for (const Timer& t : timers_) wait = std::min(wait, std::chrono::duration<double>(t.next - now).count());
+  pollfd pfd{lcm_.getFileno(), POLLIN, 0};
+  int timeout_ms = std::max(0, static_cast<int>(wait * 1000.0));
+  if (poll(&pfd, 1, timeout_ms) > 0 && (pfd.revents & POLLIN)) lcm_.handle();
+
+  now = Clock::now();
+  // Run due timers; a callback may add timers, so iterate by index over a snapshot size.
+  const size_t n = timers_.size();
+  std::vector<size_t> expired;
+  for (size_t i = 0; i < n; ++i) {
+    if (timers_[i].next > now) continue;
+    auto cb = timers_[i].cb;
+    if (timers_[i].period_s > 0)
+      timers_[i].next = now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timers_[i].period_s));
+    else
+      expired.push_back(i);
+    cb();
+  }
+  for (auto it = expired.rbegin(); it != expired.rend(); ++it) timers_.erase(timers_.begin() + *it);
+}
+
+int Node::run() {
+  installSignalHandlers();
+  every(1.0, [this] { publishStatus(); });
+  publishStatus();
+  while (!stop_ && !signalReceived()) handleOnce(0.1);
+  publishStatus();
+  return 0;
+}
+
+bool Node::spinUntil(const std::function<bool()>& pred, double timeout_s) {
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+  while (!pred()) {
+    const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
+    if (left <= 0 || signalReceived()) return pred();
+    handleOnce(std::min(left, 0.05));
+  }
+  return true;
+}
+
+int runMain(const std::string& program, const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const std::invalid_argument& e) {
+    std::cerr << program << ": " << e.what() << "\n";
+    return 2;
+  } catch (const ConfigError& e) {
+    std::cerr << program << ": config error: " << e.what() << "\n";
+    return 2;
+  } catch (const InputError& e) {
+    std::cerr << program << ": bad input: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << program << ": error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace dlslot

@@ -193,6 +193,13 @@ Node::Node(std::string name, const std::string& lcm_url, const Channels& channel
                              (lcm_url.empty() ? std::string("(default)") : lcm_url) + "'");
 }
 
+void Node::subscribeRaw(const std::string& channel, RawHandler cb) {
+  handlers_.push_back(std::move(cb));
+  lcm_.subscribeFunction<RawHandler*>(
+      channel, [](const lcm::ReceiveBuffer* rbuf, const std::string&, RawHandler* h) { (*h)(*rbuf); },
+      &handlers_.back());
+}
+
 void Node::every(double period_s, std::function<void()> cb) {
   timers_.push_back({Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s)),
                      period_s, std::move(cb)});
@@ -267,4 +274,12 @@ int runMain(const std::string& program, const std::function<int()>& body) {
   }
 }
 
+}  // namespace dlslot
+
+namespace dlslot {
+int frameOfEncoded(const void* data, size_t size) {
+  if (size < 20) return -1;
+  const auto* b = static_cast<const uint8_t*>(data) + 16;  // hash (8) + utime (8), big-endian
+  return static_cast<int32_t>((uint32_t(b[0]) << 24) | (uint32_t(b[1]) << 16) | (uint32_t(b[2]) << 8) | uint32_t(b[3]));
+}
 }  // namespace dlslot

@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <functional>
+#include <list>
 #include <map>
 #include <memory>
 #include <string>
@@ -86,6 +87,9 @@ class Node {
   ProcessStatus& status() { return status_; }
   const std::string& name() const { return name_; }
 
+  // Calls `cb` with the raw bytes of every message on `channel` (LCM 1.3 takes no lambdas).
+  using RawHandler = std::function<void(const lcm::ReceiveBuffer&)>;
+  void subscribeRaw(const std::string& channel, RawHandler cb);
   // Decodes and calls `cb`; a message that does not decode is counted and logged, never thrown.
   template <class Msg>
   void subscribe(const std::string& channel, std::function<void(const Msg&)> cb);
@@ -123,6 +127,7 @@ class Node {
   ProcessStatus status_;
   std::vector<Timer> timers_;
   std::map<std::string, int> last_frame_;
+  std::list<RawHandler> handlers_;  // stable addresses: LCM keeps a pointer to each
   bool stop_ = false;
 };
 
@@ -137,15 +142,14 @@ int runMain(const std::string& program, const std::function<int()>& body);
 // ---- template implementations ----
 template <class Msg>
 void Node::subscribe(const std::string& channel, std::function<void(const Msg&)> cb) {
-  lcm_.subscribe(channel,
-                 [this, cb, channel](const lcm::ReceiveBuffer* rbuf, const std::string&) {
-                   Msg msg;
-                   if (msg.decode(rbuf->data, 0, rbuf->data_size) < 0) {
-                     status_.decodeError(channel);
-                     return;
-                   }
-                   cb(msg);
-                 });
+  subscribeRaw(channel, [this, cb, channel](const lcm::ReceiveBuffer& rbuf) {
+    Msg msg;
+    if (msg.decode(rbuf.data, 0, rbuf.data_size) < 0) {
+      status_.decodeError(channel);
+      return;
+    }
+    cb(msg);
+  });
 }
 
 template <class Msg>
@@ -159,4 +163,11 @@ void Node::subscribeFrames(const std::string& channel, std::function<void(const 
   });
 }
 
+}  // namespace dlslot
+
+namespace dlslot {
+// Every frame-indexed message type starts with `int64_t utime; int32_t frame;`, so the frame of
+// an encoded message of any of these types is at a fixed offset after LCM's 8-byte type hash.
+// Returns -1 when the buffer is too short. (Used by the player's lockstep to follow any channel.)
+int frameOfEncoded(const void* data, size_t size);
 }  // namespace dlslot

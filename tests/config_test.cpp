@@ -1,0 +1,61 @@
+// Strict YAML config: missing, ill-typed and unknown keys are errors naming file and key.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "dlslot/config.hpp"
+
+using namespace dlslot;
+
+namespace {
+std::string writeYaml(const std::string& name, const std::string& text) {
+  const auto path = (std::filesystem::temp_directory_path() / name).string();
+  std::ofstream(path) << text;
+  return path;
+}
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(Config, ReadsTypedValuesAndSections) {
+  auto root = loadConfig(writeYaml("cfg_ok.yaml", "odometry:\n  margin: 0.5\n  name: x\n  n: 3\n  on: true\n  v: [1, 2]\n"));
+  auto s = root.section("odometry");
+  EXPECT_DOUBLE_EQ(s.get<double>("margin"), 0.5);
+  EXPECT_EQ(s.get<std::string>("name"), "x");
+  EXPECT_EQ(s.get<int>("n"), 3);
+  EXPECT_TRUE(s.get<bool>("on"));
+  EXPECT_EQ(s.get<std::vector<double>>("v").size(), 2u);
+  EXPECT_NO_THROW(s.finish());
+}
+
+TEST(Config, MissingIllTypedAndUnknownKeysAreErrors) {
+  const std::string file = writeYaml("cfg_bad.yaml", "odometry:\n  margin: abc\n  typo_key: 1\n");
+  auto s = loadConfig(file).section("odometry");
+  const std::string missing = errorOf([&] { s.get<double>("min_range"); });
+  EXPECT_NE(missing.find(file + ": odometry.min_range: missing (expected a number)"), std::string::npos) << missing;
+  const std::string typed = errorOf([&] { s.get<double>("margin"); });
+  EXPECT_NE(typed.find("odometry.margin (line 2): expected a number, got 'abc'"), std::string::npos) << typed;
+  const std::string unknown = errorOf([&] { s.finish(); });
+  EXPECT_NE(unknown.find("odometry.typo_key (line 3): unknown key"), std::string::npos) << unknown;
+}
+
+TEST(Config, MissingFileAndInvalidYaml) {
+  EXPECT_NE(errorOf([] { loadConfig("/nonexistent/dlslot.yaml"); }).find("/nonexistent/dlslot.yaml: cannot open"),
+            std::string::npos);
+  const std::string file = writeYaml("cfg_invalid.yaml", "a: [1, 2\n");
+  EXPECT_NE(errorOf([&] { loadConfig(file); }).find("not valid YAML"), std::string::npos);
+}
+
+TEST(Config, ShippedConfigHasChannels) {
+  auto root = loadConfig(std::string(DLSLOT_SOURCE_DIR) + "/config/dlslot.yaml");
+  Channels c;
+  EXPECT_NO_THROW(c.read(root.section("channels")));
+  EXPECT_EQ(c.scan, "LIDAR_SCAN");
+}

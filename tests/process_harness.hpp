@@ -1,0 +1,130 @@
+// Helpers for process-level tests: start real executables, stop them, read LCM logs back.
+// Such tests live in *_process_test.cpp files, which CTest runs inside scripts/netns-run.
+#pragma once
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <gtest/gtest.h>
+#include <lcm/lcm-cpp.hpp>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace dlslot::test {
+
+inline std::string sourceDir() { return DLSLOT_SOURCE_DIR; }
+inline std::string binDir() { return DLSLOT_BIN_DIR; }
+inline std::string bin(const std::string& name) { return binDir() + "/" + name; }
+inline std::string config() { return sourceDir() + "/config/dlslot.yaml"; }
+inline std::string realDataRoot() { return sourceDir() + "/../shared/data/kitti-tracking-0000-head"; }
+
+// A fresh scratch directory under the build tree, named after the running test.
+inline std::string scratchDir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string dir = binDir() + "/../test-scratch/" + info->test_suite_name() + "." + info->name();
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+// Fails the test unless it runs in the private namespace netns-run made.
+inline bool insidePrivateNetwork() { return std::getenv("DLSLOT_NETNS_INSIDE") != nullptr; }
+
+// A child process; its stdout+stderr go to `log_path`. Stopped with SIGINT on destruction.
+class ChildProcess {
+ public:
+  ChildProcess(std::vector<std::string> argv, std::string log_path) : log_(std::move(log_path)) {
+    pid_ = fork();
+    if (pid_ == 0) {
+      int fd = open(log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      dup2(fd, 1);
+      dup2(fd, 2);
+      std::vector<char*> args;
+      for (auto& a : argv) args.push_back(a.data());
+      args.push_back(nullptr);
+      execv(args[0], args.data());
+      _exit(127);
+    }
+  }
+  ~ChildProcess() {
+    if (running()) {
+      stop();
+    }
+  }
+  bool running() {
+    if (exited_) return false;
+    int status = 0;
+    if (waitpid(pid_, &status, WNOHANG) == pid_) {
+      exited_ = true;
+      status_ = status;
+      return false;
+    }
+    return true;
+  }
+  // Waits up to timeout_s for exit; returns the exit code (-1 on timeout, 128+sig when killed).
+  int wait(double timeout_s) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (running()) {
+      if (std::chrono::steady_clock::now() > end) return -1;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return WIFEXITED(status_) ? WEXITSTATUS(status_) : 128 + WTERMSIG(status_);
+  }
+  // SIGINT, then SIGKILL after 5 s; returns the exit code.
+  int stop() {
+    if (!running()) return wait(0);
+    kill(pid_, SIGINT);
+    int code = wait(5.0);
+    if (code == -1) {
+      kill(pid_, SIGKILL);
+      code = wait(5.0);
+    }
+    return code;
+  }
+  pid_t pid() const { return pid_; }
+  std::string output() const {
+    std::ifstream in(log_);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+
+ private:
+  pid_t pid_ = -1;
+  std::string log_;
+  bool exited_ = false;
+  int status_ = 0;
+};
+
+// All events of an LCM log, grouped by channel, in log order.
+inline std::map<std::string, std::vector<std::vector<uint8_t>>> readLog(const std::string& path) {
+  std::map<std::string, std::vector<std::vector<uint8_t>>> out;
+  lcm::LogFile log(path, "r");
+  if (!log.good()) return out;
+  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+    const auto* d = static_cast<const uint8_t*>(ev->data);
+    out[ev->channel].emplace_back(d, d + ev->datalen);
+  }
+  return out;
+}
+
+template <class Msg>
+std::vector<Msg> decodeAll(const std::vector<std::vector<uint8_t>>& raw) {
+  std::vector<Msg> out;
+  for (const auto& r : raw) {
+    Msg m;
+    if (m.decode(r.data(), 0, r.size()) >= 0) out.push_back(m);
+  }
+  return out;
+}
+
+}  // namespace dlslot::test

@@ -17,7 +17,9 @@ struct Calib {
   Eigen::Matrix3d R_rect = Eigen::Matrix3d::Identity();
   Pose T_cam_velo = Pose::Identity();              // Tr_velo_cam: velodyne -> camera 0
   std::optional<Pose> T_velo_imu;                  // Tr_imu_velo: imu -> velodyne
-  std::array<Eigen::Matrix<double, 3, 4>, 4> P{};  // P0..P3 (zero when absent)
+  using Projection = Eigen::Matrix<double, 3, 4>;
+  std::array<Projection, 4> P = {Projection::Zero(), Projection::Zero(), Projection::Zero(),
+                                 Projection::Zero()};  // P0..P3 (zero when absent)
 
   // Rectified camera frame <- velodyne: p_rect = R_rect * T_cam_velo * p_velo.
   Pose T_rect_velo() const;

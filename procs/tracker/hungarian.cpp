@@ -1,0 +1,83 @@
+#include "hungarian.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace dlslot::tracker {
+namespace {
+
+// The square-or-wide case (n <= m). Rows are added one at a time; each addition grows a tree of
+// tight edges (reduced cost zero under the potentials u, v) from the new row until it reaches a
+// free column, adjusting the potentials by the smallest slack when the tree gets stuck, then
+// flips the path. Column 0 is a sentinel that holds the row being inserted.
+std::vector<int> solveWide(const Eigen::MatrixXd& c) {
+  const int n = static_cast<int>(c.rows()), m = static_cast<int>(c.cols());
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::vector<double> u(n + 1, 0.0), v(m + 1, 0.0);
+  std::vector<int> row_of(m + 1, 0);   // row (1-based) matched to column j, 0 = free
+  std::vector<int> parent(m + 1, 0);   // previous column on the alternating path
+  std::vector<double> slack(m + 1);
+  std::vector<char> in_tree(m + 1);
+
+  for (int i = 1; i <= n; ++i) {
+    row_of[0] = i;
+    int col = 0;
+    std::fill(slack.begin(), slack.end(), kInf);
+    std::fill(in_tree.begin(), in_tree.end(), 0);
+    do {
+      in_tree[col] = 1;
+      const int row = row_of[col];
+      double delta = kInf;
+      int next = 0;
+      for (int j = 1; j <= m; ++j) {
+        if (in_tree[j]) continue;
+        const double reduced = c(row - 1, j - 1) - u[row] - v[j];
+        if (reduced < slack[j]) {
+          slack[j] = reduced;
+          parent[j] = col;
+        }
+        if (slack[j] < delta) {
+          delta = slack[j];
+          next = j;
+        }
+      }
+      for (int j = 0; j <= m; ++j) {
+        if (in_tree[j]) {
+          u[row_of[j]] += delta;
+          v[j] -= delta;
+        } else {
+          slack[j] -= delta;
+        }
+      }
+      col = next;
+    } while (row_of[col] != 0);
+    // Augment: shift the matches back along the path to the sentinel.
+    while (col != 0) {
+      const int prev = parent[col];
+      row_of[col] = row_of[prev];
+      col = prev;
+    }
+  }
+
+  std::vector<int> col_of_row(n, -1);
+  for (int j = 1; j <= m; ++j)
+    if (row_of[j] != 0) col_of_row[row_of[j] - 1] = j - 1;
+  return col_of_row;
+}
+
+}  // namespace
+
+std::vector<int> solveAssignment(const Eigen::MatrixXd& cost) {
+  if (!cost.allFinite()) throw std::invalid_argument("solveAssignment: every cost must be finite");
+  if (cost.rows() == 0 || cost.cols() == 0) return std::vector<int>(cost.rows(), -1);
+  if (cost.rows() <= cost.cols()) return solveWide(cost);
+
+  // Tall: assign the columns to rows instead, then invert the answer.
+  const std::vector<int> row_of_col = solveWide(cost.transpose());
+  std::vector<int> col_of_row(cost.rows(), -1);
+  for (int j = 0; j < static_cast<int>(row_of_col.size()); ++j) col_of_row[row_of_col[j]] = j;
+  return col_of_row;
+}
+
+}  // namespace dlslot::tracker

@@ -1,0 +1,190 @@
+// dlslot-tracker: sliding-window trajectory association (paper III-B, III-D) over LCM.
+// Joins DETECTIONS and ODOMETRY of each scan by frame, puts the detections in the world frame
+// with the best ego pose known (SLOT_STATE, else chained odometry), associates them with the
+// trajectories of the window and publishes ASSOCIATIONS.
+#include <chrono>
+#include <string>
+
+#include "dlslot/associations_t.hpp"
+#include "dlslot/convert.hpp"
+#include "dlslot/detections_t.hpp"
+#include "dlslot/node.hpp"
+#include "dlslot/odometry_t.hpp"
+#include "dlslot/slot_state_t.hpp"
+#include "ego_pose_chain.hpp"
+#include "frame_joiner.hpp"
+#include "trajectory_associator.hpp"
+
+using namespace dlslot;
+using namespace dlslot::tracker;
+
+namespace {
+
+struct TrackerConfig {
+  AssociatorConfig associator;
+  double join_timeout_s = 2.0;
+
+  void read(ConfigSection s) {
+    s.get("window_frames", associator.window_frames);
+    s.get("init_observations", associator.init_observations);
+    s.get("gate_sq_m2", associator.gate_sq_m2);
+    s.get("max_missed_frames", associator.max_missed_frames);
+    s.get("max_polynomial_degree", associator.max_polynomial_degree);
+    s.get("dynamic_displacement_m", associator.dynamic_displacement_m);
+    s.get("join_timeout_s", join_timeout_s);
+    const std::string predictor = s.get<std::string>("predictor");
+    s.finish();
+    try {
+      associator.predictor = predictorFromName(predictor);
+      associator.validate();
+      if (!(join_timeout_s > 0)) throw std::invalid_argument("join_timeout_s: expected > 0");
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(s.file() + ": " + s.path() + "." + e.what());
+    }
+  }
+};
+
+double secondsNow() {
+  return std::chrono::duration<double>(Node::Clock::now().time_since_epoch()).count();
+}
+
+// Splits a DETECTIONS message into well-formed boxes and a count of malformed ones.
+DetectionFrame toDetectionFrame(const detections_t& msg) {
+  DetectionFrame d;
+  d.utime = msg.utime;
+  for (int i = 0; i < static_cast<int>(msg.boxes.size()); ++i) {
+    if (!isValid(msg.boxes[i])) {
+      ++d.num_rejected;
+      continue;
+    }
+    d.boxes.push_back(fromMsg(msg.boxes[i]));
+    d.message_index.push_back(i);
+  }
+  return d;
+}
+
+associations_t toMsg(const JoinedFrame& joined, const EgoPose& ego, const FrameAssociations& result) {
+  associations_t m;
+  m.utime = joined.utime;
+  m.frame = joined.frame;
+  m.ego_pose = dlslot::toMsg(ego.X);
+  m.ego_pose_source = poseSourceName(ego.source);
+  m.num_active_tracks = result.num_active_tracks;
+  m.num_rejected = joined.detections ? joined.detections->num_rejected : 0;
+  for (const Association& a : result.associations) {
+    association_t out;
+    out.detection_index = joined.detections->message_index[a.detection_index];
+    out.track_id = a.track_id;
+    out.initialized = a.initialized;
+    out.num_observations = a.num_observations;
+    out.box_lidar = dlslot::toMsg(a.box_lidar);
+    out.box_world = dlslot::toMsg(a.box_world);
+    out.box_lidar.id = out.box_world.id = a.track_id;
+    out.has_prediction = a.predicted.has_value();
+    const Eigen::Vector3d p = a.predicted.value_or(Eigen::Vector3d::Zero());
+    for (int k = 0; k < 3; ++k) out.predicted[k] = p[k];
+    out.is_dynamic = a.is_dynamic;
+    out.displacement = a.displacement;
+    m.associations.push_back(out);
+  }
+  m.num_associations = static_cast<int32_t>(m.associations.size());
+  return m;
+}
+
+int run(int argc, char** argv) {
+  NodeOptions node_opts;
+  CommandLine cl("dlslot-tracker",
+                 "Associates each scan's detections with the trajectories of a sliding window (DL-SLOT III-B).\n"
+                 "Subscribes DETECTIONS, ODOMETRY, SLOT_STATE; publishes ASSOCIATIONS and PROCESS_STATUS.");
+  node_opts.addTo(cl);
+  if (!cl.parse(argc, argv)) return 0;
+
+  ConfigSection root_cfg = loadConfig(node_opts.config);
+  Channels channels;
+  channels.read(root_cfg.section("channels"));
+  TrackerConfig cfg;
+  cfg.read(root_cfg.section("tracker"));
+  if (node_opts.check_config) return 0;
+
+  Node node("tracker", node_opts.lcm_url, channels);
+  ProcessStatus& status = node.status();
+  TrajectoryAssociator associator(cfg.associator);
+  EgoPoseChain ego_poses;
+  FrameJoiner joiner(cfg.join_timeout_s);
+
+  auto process = [&](const JoinedFrame& joined) {
+    const auto tic = Node::Clock::now();
+    const std::string frame = std::to_string(joined.frame);
+    if (!joined.has_odometry) {
+      status.timeout(channels.odometry + " for frame " + frame + " not within " +
+                     std::to_string(cfg.join_timeout_s) + " s; ego motion predicted");
+      status.count("odometry_missing");
+    }
+    if (!joined.detections) {
+      status.timeout(channels.detections + " for frame " + frame + " not within " +
+                     std::to_string(cfg.join_timeout_s) + " s; frame handled as empty");
+      status.count("detections_missing");
+    }
+    const EgoPose ego = ego_poses.poseAt(joined.frame);
+    status.count(std::string("pose_source_") + poseSourceName(ego.source));
+    static const std::vector<Box> kNone;
+    const std::vector<Box>& boxes = joined.detections ? joined.detections->boxes : kNone;
+    const FrameAssociations result = associator.associate(joined.frame, joined.utime * 1e-6, ego.X, boxes);
+    ego_poses.forgetBefore(joined.frame);
+
+    for (const Association& a : result.associations) {
+      if (a.new_track) status.count("tracks_started");
+      if (a.initialized) status.count("associations_initialized");
+    }
+    status.count("tracks_ended", result.num_ended_tracks);
+    status.count("associations", static_cast<int64_t>(result.associations.size()));
+
+    associations_t msg = toMsg(joined, ego, result);
+    const double ms = std::chrono::duration<double, std::milli>(Node::Clock::now() - tic).count();
+    msg.timings = dlslot::toMsg(StageTimings{{"total", ms}});
+    msg.num_timings = static_cast<int32_t>(msg.timings.size());
+    node.publish(channels.associations, msg);
+    status.frameDone(joined.frame, ms);
+  };
+  auto releaseReady = [&] {
+    for (const JoinedFrame& joined : joiner.release(secondsNow())) process(joined);
+  };
+  // A frame 0 after later frames: the player started again. Start from scratch.
+  auto restartIfRewound = [&](int frame) {
+    if (frame != 0 || joiner.lastReleased() < 0) return;
+    status.warn("frame 0 after frame " + std::to_string(joiner.lastReleased()) + ": input restarted, tracker reset");
+    associator.reset();
+    joiner.reset();
+    ego_poses = EgoPoseChain();
+  };
+
+  node.subscribeFrames<detections_t>(channels.detections, [&](const detections_t& msg) {
+    restartIfRewound(msg.frame);
+    DetectionFrame d = toDetectionFrame(msg);
+    if (d.num_rejected > 0) {
+      status.error(channels.detections + " frame " + std::to_string(msg.frame) + ": " +
+                   std::to_string(d.num_rejected) + " malformed box(es) (NaN/inf field or size <= 0) rejected");
+      status.count("rejected_detections", d.num_rejected);
+    }
+    if (!joiner.addDetections(msg.frame, std::move(d), secondsNow())) status.count("stale_messages");
+    releaseReady();
+  });
+  node.subscribeFrames<odometry_t>(channels.odometry, [&](const odometry_t& msg) {
+    restartIfRewound(msg.frame);
+    if (!joiner.addOdometry(msg.frame, msg.utime, secondsNow())) {
+      status.count("stale_messages");
+      return;
+    }
+    ego_poses.addOdometry(msg.frame, fromMsg(msg.pose), fromMsg(msg.delta));
+    releaseReady();
+  });
+  node.subscribe<slot_state_t>(channels.slot_state, [&](const slot_state_t& msg) {
+    ego_poses.addOptimized(msg.frame, fromMsg(msg.ego_pose));
+  });
+  node.every(0.02, releaseReady);
+  return node.run();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return runMain("dlslot-tracker", [&] { return run(argc, argv); }); }

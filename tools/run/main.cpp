@@ -1,0 +1,247 @@
+// dlslot-run: runs the whole DL-SLOT pipeline on one sequence and collects every output.
+//
+// Starts lcm-logger, the renderer, backend, tracker and odometry, waits until each reports on
+// PROCESS_STATUS, then plays the sequence (lockstep on SLOT_STATE by default). It watches every
+// process: one that dies, or a pipeline that stops making progress, ends the run with an error
+// naming the process and its last log lines. At the end it stops everything cleanly and runs the
+// evaluator. Run it inside scripts/netns-run (./dlslot run does) unless --lcm-url is given.
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <thread>
+#include <algorithm>
+
+#include "dlslot/kitti.hpp"
+#include "dlslot/node.hpp"
+#include "dlslot/process_status_t.hpp"
+#include "dlslot/progress.hpp"
+#include "dlslot/slot_state_t.hpp"
+#include "supervisor.hpp"
+
+using namespace dlslot;
+namespace fs = std::filesystem;
+
+namespace {
+
+// The paper's comparison modes (Table I) as odometry and backend settings.
+struct ModeSettings {
+  std::string odometry, backend;
+};
+ModeSettings settingsFor(const std::string& mode) {
+  if (mode == "slot") return {"aloam-filtered", "slot"};
+  if (mode == "aloam") return {"aloam", "odometry-only"};
+  if (mode == "aloam-filtered") return {"aloam-filtered", "odometry-only"};
+  if (mode == "two-stage") return {"aloam-filtered", "two-stage"};
+  throw std::invalid_argument("--mode: expected slot, aloam, aloam-filtered or two-stage, got '" + mode + "'");
+}
+
+std::string binDir() { return fs::read_symlink("/proc/self/exe").parent_path().string(); }
+
+// Runs a command to completion with output to log; returns its exit code.
+int runToEnd(run::Supervisor& sup, const std::string& name, const std::vector<std::string>& argv,
+             const std::string& log) {
+  sup.start(name, argv, log);
+  while (sup.running(name)) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  return sup.stop(name);
+}
+
+struct Failure : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+int runPipeline(int argc, char** argv) {
+  std::string root, sequence = "0000", scenario, mode = "slot", config = "config/dlslot.yaml", out, lcm_url;
+  std::vector<std::string> detections;
+  int frames = -1, seed = 1;
+  double speed = 0, stall_s = 60, start_timeout_s = 30;
+  bool no_eval = false, no_render = false, quiet = false;
+  CommandLine cl("dlslot-run", "Runs player, odometry, tracker, backend, renderer and lcm-logger on one sequence.");
+  cl.option("--kitti", &root, "KITTI root (holding training/ or sequences/)");
+  cl.option("--sequence", &sequence, "sequence (default 0000)");
+  cl.repeated("--detections", &detections, "detection file or directory");
+  cl.option("--scenario", &scenario, "simulate this scenario (name or YAML) first, then run on it");
+  cl.option("--frames", &frames, "frames to simulate (with --scenario) or to play (default: all)");
+  cl.option("--seed", &seed, "simulator seed (default 1)");
+  cl.option("--mode", &mode, "slot | aloam | aloam-filtered | two-stage (default slot)");
+  cl.option("--config", &config, "YAML config (default config/dlslot.yaml)");
+  cl.option("--out", &out, "output directory");
+  cl.option("--lcm-url", &lcm_url, "LCM URL for every process (default: $LCM_DEFAULT_URL)");
+  cl.option("--speed", &speed, "rate mode at this real-time factor instead of lockstep");
+  cl.option("--stall-timeout", &stall_s, "seconds without progress before the run fails (default 60)");
+  cl.flag("--no-eval", &no_eval, "skip the evaluation");
+  cl.flag("--no-render", &no_render, "do not start the renderer");
+  cl.flag("--quiet", &quiet, "no progress line");
+  if (!cl.parse(argc, argv)) return 0;
+  if (out.empty()) throw std::invalid_argument("--out DIR is required");
+  if (root.empty() == scenario.empty()) throw std::invalid_argument("give either --kitti ROOT or --scenario NAME");
+  const ModeSettings ms = settingsFor(mode);
+  const std::string bin = binDir();
+  fs::create_directories(out + "/logs");
+  out = fs::canonical(out).string();
+  const std::string logs = out + "/logs";
+  run::Supervisor sup;
+
+  // 1. The config is checked by every process before anything starts.
+  {
+    ConfigSection cfg = loadConfig(config);  // throws a clear ConfigError
+    (void)cfg;
+    fs::copy_file(config, out + "/config.yaml", fs::copy_options::overwrite_existing);
+    for (const std::string p : {"player", "odometry", "tracker", "backend", "renderer"}) {
+      if (no_render && p == "renderer") continue;
+      const std::string log = logs + "/check-" + p + ".log";
+      if (runToEnd(sup, "check-" + p, {bin + "/dlslot-" + p, "--config", config, "--check-config"}, log) != 0)
+        throw ConfigError("dlslot-" + p + " refused the config:\n" + run::readText(log));
+    }
+  }
+
+  // 2. Simulate when asked.
+  if (!scenario.empty()) {
+    root = out + "/data";
+    std::vector<std::string> sim = {bin + "/dlslot-sim", "--scenario", scenario, "--out", root, "--seed",
+                                    std::to_string(seed), "--sequence", sequence};
+    if (frames > 0) sim.insert(sim.end(), {"--frames", std::to_string(frames)});
+    std::cerr << "simulating " << scenario << " ...\n";
+    if (runToEnd(sup, "sim", sim, logs + "/sim.log") != 0)
+      throw Failure("dlslot-sim failed:\n" + sup.tail("sim"));
+    detections = {root + "/detections/sim"};
+  }
+  const int num_frames = kitti::locateSequence(root, sequence).num_frames;
+  const int last_frame = (frames > 0 && scenario.empty()) ? std::min(frames, num_frames) - 1 : num_frames - 1;
+
+  // 3. Start the pipeline, consumers first.
+  Node node("launcher", lcm_url);
+  std::vector<std::string> common = {"--config", config};
+  if (!lcm_url.empty()) common.insert(common.end(), {"--lcm-url", lcm_url});
+  auto args = [&](const std::string& exe, std::vector<std::string> extra) {
+    std::vector<std::string> a = {exe};
+    a.insert(a.end(), common.begin(), common.end());
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+  };
+  std::vector<std::string> logger = {"/usr/bin/lcm-logger", "--quiet", "--force", out + "/run.lcmlog"};
+  if (!lcm_url.empty()) logger.insert(logger.begin() + 1, "--lcm-url=" + lcm_url);
+  sup.start("lcm-logger", logger, logs + "/lcm-logger.log");
+  std::vector<std::string> pipeline = {"backend", "tracker", "odometry"};
+  if (!no_render) {
+    pipeline.insert(pipeline.begin(), "renderer");
+    sup.start("renderer", args(bin + "/dlslot-renderer", {"--out", out + "/bev"}), logs + "/renderer.log");
+  }
+  sup.start("backend", args(bin + "/dlslot-backend", {"--mode", ms.backend}), logs + "/backend.log");
+  sup.start("tracker", args(bin + "/dlslot-tracker", {}), logs + "/tracker.log");
+  sup.start("odometry", args(bin + "/dlslot-odometry", {"--mode", ms.odometry}), logs + "/odometry.log");
+
+  std::map<std::string, process_status_t> health;
+  int slot_frames = 0, slot_last = -1;
+  auto last_progress = Node::Clock::now();
+  node.subscribe<process_status_t>("PROCESS_STATUS", [&](const process_status_t& s) { health[s.name] = s; });
+  node.subscribeFrames<slot_state_t>("SLOT_STATE", [&](const slot_state_t& s) {
+    ++slot_frames;
+    slot_last = s.frame;
+    last_progress = Node::Clock::now();
+  });
+  auto failIfDead = [&](const std::string& except) {
+    while (auto e = sup.reap())
+      if (e->name != except || e->code != 0)
+        throw Failure(e->name + " " + e->how + "; its last lines (" + sup.logPath(e->name) + "):\n" + sup.tail(e->name));
+  };
+  auto allUp = [&] {
+    for (const auto& p : pipeline)
+      if (!health.count(p)) return false;
+    return true;
+  };
+  installSignalHandlers();
+  const auto up_deadline = Node::Clock::now() + std::chrono::duration<double>(start_timeout_s);
+  while (!allUp()) {
+    failIfDead("");
+    if (Node::Clock::now() > up_deadline) {
+      std::string missing;
+      for (const auto& p : pipeline)
+        if (!health.count(p)) missing += " " + p;
+      throw Failure("no PROCESS_STATUS within " + std::to_string(int(start_timeout_s)) + " s from:" + missing);
+    }
+    node.spinUntil([] { return false; }, 0.1);
+  }
+
+  // 4. Play, watching every process.
+  std::vector<std::string> play = {"--kitti", root, "--sequence", sequence, "--quiet", "--delay", "0.2",
+                                   "--end", std::to_string(last_frame)};
+  for (const auto& d : detections) play.insert(play.end(), {"--detections", d});
+  if (speed > 0)
+    play.insert(play.end(), {"--speed", std::to_string(speed)});
+  else
+    play.insert(play.end(), {"--lockstep", "SLOT_STATE"});
+  sup.start("player", args(bin + "/dlslot-player", play), logs + "/player.log");
+  ProgressLine progress("run " + (scenario.empty() ? sequence : scenario) + " [" + mode + "]", last_frame + 1);
+  last_progress = Node::Clock::now();
+  auto healthText = [&] {
+    std::ostringstream os;
+    for (const auto& p : pipeline) {
+      const auto it = health.find(p);
+      const bool alive = sup.running(p);
+      os << p << (alive ? "" : "(dead)");
+      if (it != health.end()) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, " %.0fms", it->second.time_mean_ms);
+        os << buf;
+        const int64_t bad = it->second.decode_errors + it->second.timeouts + it->second.errors + it->second.frame_gaps;
+        if (bad) os << " !" << bad;
+      }
+      os << "  ";
+    }
+    return os.str();
+  };
+  while (sup.running("player") || slot_last < last_frame) {
+    if (signalReceived()) throw Failure("interrupted");
+    failIfDead("player");
+    const double idle = std::chrono::duration<double>(Node::Clock::now() - last_progress).count();
+    if (idle > stall_s) {
+      std::string detail;
+      for (const auto& p : pipeline) detail += "  " + p + ":\n" + sup.tail(p, 5);
+      throw Failure("pipeline stalled: no SLOT_STATE for " + std::to_string(int(stall_s)) + " s after frame " +
+                    std::to_string(slot_last) + "\n" + detail);
+    }
+    if (!sup.running("player") && idle > 10) break;  // the player is done; the tail is not coming
+    node.spinUntil([] { return false; }, 0.1);
+    if (!quiet) progress.update(slot_last + 1, healthText());
+  }
+  if (!quiet) progress.finish(healthText());
+  failIfDead("player");
+
+  // 5. Stop in pipeline order so every process flushes (the renderer writes its summary, the
+  // logger closes the log).
+  for (const std::string p : {"odometry", "tracker", "backend", "renderer"}) {
+    if (p == std::string("renderer") && no_render) continue;
+    const int code = sup.stop(p, p == std::string("renderer") ? 60.0 : 10.0);
+    if (code != 0) throw Failure(p + " did not exit cleanly (code " + std::to_string(code) + "):\n" + sup.tail(p));
+  }
+  node.spinUntil([] { return false; }, 0.3);
+  sup.stop("lcm-logger");
+  std::cerr << "SLOT_STATE for " << slot_frames << " of " << last_frame + 1 << " frames\n";
+  if (slot_frames != last_frame + 1) std::cerr << "warning: frames are missing from SLOT_STATE\n";
+
+  // 6. Evaluate and export.
+  if (!no_eval) {
+    std::vector<std::string> eval = args(bin + "/dlslot-eval", {"--log", out + "/run.lcmlog", "--kitti", root,
+                                                                "--sequence", sequence, "--out", out, "--export", out});
+    eval.erase(std::remove(eval.begin(), eval.end(), std::string("--lcm-url")), eval.end());
+    if (runToEnd(sup, "eval", eval, logs + "/eval.log") != 0) throw Failure("dlslot-eval failed:\n" + sup.tail("eval", 30));
+    std::cout << run::readText(logs + "/eval.log");
+  }
+  std::cout << "outputs in " << out << ": run.lcmlog, trajectory_*.txt, tracks_kitti.txt, metrics.json, report.md, "
+            << (no_render ? "" : "bev/, ") << "plots/, config.yaml, logs/\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return runMain("dlslot-run", [&] {
+    try {
+      return runPipeline(argc, argv);
+    } catch (const Failure& f) {
+      std::cerr << "\ndlslot-run: FAILED: " << f.what() << "\n";
+      return 3;
+    }
+  });
+}

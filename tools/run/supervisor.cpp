@@ -1,0 +1,123 @@
+#include "supervisor.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <deque>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+namespace dlslot::run {
+
+Supervisor::~Supervisor() { stopAll(2.0); }
+
+void Supervisor::start(const std::string& name, const std::vector<std::string>& argv, const std::string& log_path) {
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("cannot start " + name + ": fork failed");
+  if (pid == 0) {
+    const int fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) {
+      dup2(fd, 1);
+      dup2(fd, 2);
+    }
+    setpgid(0, 0);  // a Ctrl-C on the terminal reaches the launcher, which stops children in order
+    std::vector<char*> args;
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    execv(args[0], args.data());
+    std::fprintf(stderr, "cannot execute %s\n", args[0]);
+    _exit(127);
+  }
+  children_.push_back({name, log_path, pid});
+}
+
+std::string Supervisor::describe(int code) {
+  if (code > 128) return "killed by signal " + std::to_string(code - 128);
+  return "exited with code " + std::to_string(code);
+}
+
+std::optional<Supervisor::Exit> Supervisor::reap() {
+  for (Child& c : children_) {
+    if (c.done) continue;
+    int status = 0;
+    if (waitpid(c.pid, &status, WNOHANG) == c.pid) {
+      c.done = true;
+      c.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      return Exit{c.name, c.code, describe(c.code)};
+    }
+  }
+  return std::nullopt;
+}
+
+bool Supervisor::running(const std::string& name) {
+  Child& c = find(name);
+  if (c.done) return false;
+  int status = 0;
+  if (waitpid(c.pid, &status, WNOHANG) == c.pid) {
+    c.done = true;
+    c.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  }
+  return !c.done;
+}
+
+int Supervisor::stop(const std::string& name, double grace_s) {
+  Child& c = find(name);
+  if (!running(name)) return c.code;
+  kill(c.pid, SIGINT);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(grace_s);
+  while (running(name) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  if (running(name)) {
+    kill(c.pid, SIGKILL);
+    int status = 0;
+    waitpid(c.pid, &status, 0);
+    c.done = true;
+    c.code = 128 + SIGKILL;
+  }
+  return c.code;
+}
+
+void Supervisor::stopAll(double grace_s) {
+  for (auto it = children_.rbegin(); it != children_.rend(); ++it)
+    if (!it->done) stop(it->name, grace_s);
+}
+
+std::string Supervisor::tail(const std::string& name, int n) const {
+  std::ifstream in(find(name).log);
+  std::deque<std::string> lines;
+  for (std::string line; std::getline(in, line);) {
+    lines.push_back(line);
+    if (static_cast<int>(lines.size()) > n) lines.pop_front();
+  }
+  std::string out;
+  for (const auto& l : lines) out += "    " + l + "\n";
+  return out;
+}
+
+const std::string& Supervisor::logPath(const std::string& name) const { return find(name).log; }
+
+Supervisor::Child& Supervisor::find(const std::string& name) {
+  for (Child& c : children_)
+    if (c.name == name) return c;
+  throw std::logic_error("no process named " + name);
+}
+
+const Supervisor::Child& Supervisor::find(const std::string& name) const {
+  for (const Child& c : children_)
+    if (c.name == name) return c;
+  throw std::logic_error("no process named " + name);
+}
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace dlslot::run

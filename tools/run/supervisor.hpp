@@ -1,0 +1,56 @@
+// Starts the pipeline's processes, watches them, and stops them cleanly: the launcher's
+// LCM-free part. Each child's stdout and stderr go to its own log file, so a failure can be
+// reported with the process's name and its last lines.
+#pragma once
+
+#include <sys/types.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace dlslot::run {
+
+class Supervisor {
+ public:
+  ~Supervisor();  // stops whatever still runs
+
+  // Starts argv[0] with argv; output to log_path. Throws std::runtime_error when fork fails.
+  void start(const std::string& name, const std::vector<std::string>& argv, const std::string& log_path);
+
+  // A child that has exited since the last call: its name and a description ("exited with
+  // code 3", "killed by signal 9"). Children stopped by stop() are not reported.
+  struct Exit {
+    std::string name;
+    int code = 0;  // exit code, or 128 + signal
+    std::string how;
+  };
+  std::optional<Exit> reap();
+  bool running(const std::string& name);
+
+  // SIGINT to `name`, SIGKILL after grace_s; returns its exit code (128 + signal when killed).
+  int stop(const std::string& name, double grace_s = 5.0);
+  // Stops every running child, newest first.
+  void stopAll(double grace_s = 5.0);
+
+  // The last n lines of a child's log.
+  std::string tail(const std::string& name, int n = 15) const;
+  const std::string& logPath(const std::string& name) const;
+
+ private:
+  struct Child {
+    std::string name, log;
+    pid_t pid = -1;
+    bool done = false;
+    int code = 0;
+  };
+  Child& find(const std::string& name);
+  const Child& find(const std::string& name) const;
+  static std::string describe(int code);
+  std::vector<Child> children_;
+};
+
+// Reads a small text file whole ("" when missing).
+std::string readText(const std::string& path);
+
+}  // namespace dlslot::run

@@ -1,0 +1,27 @@
+// CLEAR MOT (Bernardin & Stiefelhagen 2008) in bird's-eye view, frame by frame in each scan's
+// lidar frame: correspondences of the previous frame are kept while they stay within the gate,
+// the rest is matched by minimum total cost (Hungarian); an identity switch is a label matched to
+// another track than the one it was last matched to.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "tracking_frames.hpp"
+
+namespace dlslot::eval {
+
+struct ClearMot {
+  int num_truth = 0;  // labelled objects over all frames (ignore regions excluded)
+  int tp = 0, fp = 0, fn = 0, idsw = 0;
+  std::optional<double> mota;    // 1 - (FN + FP + IDSW) / num_truth; null without labels
+  std::optional<double> motp_m;  // mean bird's-eye centre distance of the matched pairs
+  // Velocity error of matched labels that are dynamic and have a velocity on both sides.
+  int velocity_pairs = 0;
+  std::optional<double> velocity_rmse_mps;
+};
+
+// `frames` in scan order, ignored tracks already removed (dropIgnoredTracks).
+ClearMot evaluateClearMot(const std::vector<TrackingFrame>& frames, const MatchCriterion& criterion);
+
+}  // namespace dlslot::eval

@@ -1,0 +1,84 @@
+#include "evaluation.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <stdexcept>
+
+#include "velocity.hpp"
+
+namespace dlslot::eval {
+
+std::string primarySource(const std::map<std::string, Trajectory>& sources) {
+  if (sources.count("slot")) return "slot";
+  if (sources.count("odometry")) return "odometry";
+  return sources.empty() ? "" : sources.begin()->first;
+}
+
+namespace {
+
+// Labels and tracks get velocities the same way, in the world when both sides have poses,
+// else relative to the sensor. Returns how they were compared, for the report.
+std::string assignVelocities(RunData& run, double dynamic_speed_mps) {
+  auto& frames = run.tracking;
+  const bool truth_world = std::all_of(frames.begin(), frames.end(), [](const TrackingFrame& f) { return f.truth_pose.has_value(); });
+  const bool tracks_world = run.track_velocities_given ||
+                            std::all_of(frames.begin(), frames.end(), [](const TrackingFrame& f) { return f.ego_pose.has_value(); });
+  char speed[32];
+  std::snprintf(speed, sizeof speed, "%g", dynamic_speed_mps);
+  std::string how;
+  if (truth_world && tracks_world) {
+    finiteDifferenceVelocities(frames, Side::Truth, VelocityFrame::World, true);
+    finiteDifferenceVelocities(frames, Side::Tracks, VelocityFrame::World, false);
+    markDynamicLabels(frames, VelocityFrame::World, dynamic_speed_mps);
+    how = "world frame (velocity over ground, compared in each scan's lidar axes); labels: differences of "
+          "consecutive labelled positions put in the world with the ground-truth poses; tracks: " +
+          std::string(run.track_velocities_given ? "the system's own velocity estimates"
+                                                 : "differences of positions put in the world with the system's poses") +
+          "; dynamic = labelled speed >= " + speed + " m/s";
+  } else {
+    finiteDifferenceVelocities(frames, Side::Truth, VelocityFrame::Sensor, true);
+    finiteDifferenceVelocities(frames, Side::Tracks, VelocityFrame::Sensor, true);
+    markDynamicLabels(frames, VelocityFrame::Sensor, dynamic_speed_mps);
+    how = "sensor frame (no ground-truth poses): velocity relative to the sensor, from differences of consecutive "
+          "positions in the lidar frames, for labels and tracks alike; every matched label counts";
+  }
+  return how;
+}
+
+TrackingMetrics trackingMetrics(std::vector<TrackingFrame> frames, const MatchCriterion& criterion) {
+  dropIgnoredTracks(frames, criterion);
+  return {criterion, evaluateClearMot(frames, criterion), evaluateHota(frames, criterion)};
+}
+
+}  // namespace
+
+Metrics evaluate(RunData run, const EvalOptions& options) {
+  Metrics m;
+  m.primary_source = primarySource(run.sources);
+  for (const auto& [name, trajectory] : run.sources) {
+    if (!run.truth) {
+      m.ego[name] = std::nullopt;
+      continue;
+    }
+    const auto [est, gt] = commonFrames(trajectory, *run.truth);
+    if (est.empty())
+      throw std::invalid_argument("the '" + name + "' trajectory (" + std::to_string(trajectory.size()) +
+                                  " poses) and the ground truth share no frame");
+    if (est.size() < trajectory.size())
+      m.notes.push_back("source '" + name + "': " + std::to_string(trajectory.size() - est.size()) +
+                        " poses have no ground truth and were not evaluated");
+    m.ego[name] = evaluateEgo(est, gt);
+  }
+  if (run.has_labels && run.has_tracks) {
+    restrictClasses(run.tracking, options.classes);
+    m.velocity_frame = assignVelocities(run, options.dynamic_speed_mps);
+    m.tracking = trackingMetrics(run.tracking, options.distance);
+    m.tracking_iou = trackingMetrics(run.tracking, options.iou);
+  }
+  m.timing_ms = std::move(run.timing_ms);
+  m.frame_counts = std::move(run.frame_counts);
+  m.notes.insert(m.notes.end(), run.notes.begin(), run.notes.end());
+  return m;
+}
+
+}  // namespace dlslot::eval

@@ -1,0 +1,60 @@
+// One evaluation of a run: everything read from a log or from files goes into RunData, and
+// evaluate() turns it into the metrics of the design brief (section 5).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "clear_mot.hpp"
+#include "dlslot/timing_stats.hpp"
+#include "ego_metrics.hpp"
+#include "hota.hpp"
+#include "tracking_frames.hpp"
+
+namespace dlslot::eval {
+
+struct RunData {
+  std::map<std::string, Trajectory> sources;  // the system's ego trajectories, by source name
+  std::optional<Trajectory> truth;            // ground-truth T_world_lidar
+  // Tracking: one entry per labelled scan the run covers, tracks in the scan's lidar frame.
+  bool has_labels = false;
+  bool has_tracks = false;
+  bool track_velocities_given = false;  // tracks carry the system's own velocity estimate (SLOT_STATE)
+  std::vector<TrackingFrame> tracking;
+  std::map<std::string, TimingStats> timing_ms;  // module -> per-frame processing time
+  std::map<std::string, int64_t> frame_counts;   // channel -> messages in the log
+  std::vector<std::string> notes;                // facts for the report (process health, warnings)
+};
+
+struct EvalOptions {
+  MatchCriterion distance;                                              // CLEAR MOT / HOTA, first line
+  MatchCriterion iou{MatchCriterion::Kind::Iou3d};                      // second line
+  double dynamic_speed_mps = 0.5;  // labels moving at least this fast count for the velocity RMSE
+  std::vector<std::string> classes;  // evaluated classes; empty = all
+};
+
+struct TrackingMetrics {
+  MatchCriterion criterion;
+  ClearMot clear;
+  std::optional<Hota> hota;
+};
+
+struct Metrics {
+  std::string primary_source;                               // "slot", else "odometry", else the first
+  std::map<std::string, std::optional<EgoMetrics>> ego;     // per source; null without ground truth
+  std::optional<TrackingMetrics> tracking, tracking_iou;    // null without labels or without tracks
+  std::string velocity_frame;                               // how velocities were compared
+  std::map<std::string, TimingStats> timing_ms;
+  std::map<std::string, int64_t> frame_counts;
+  std::vector<std::string> notes;
+};
+
+std::string primarySource(const std::map<std::string, Trajectory>& sources);
+
+// Throws std::invalid_argument when a trajectory and the ground truth share no frame.
+Metrics evaluate(RunData run, const EvalOptions& options);
+
+}  // namespace dlslot::eval

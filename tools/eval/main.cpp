@@ -1,0 +1,287 @@
+// dlslot-eval: turns a recorded run (LCM log) or result files into the metrics of the design
+// brief (section 5): metrics.json, report.md and plots, a summary on stdout; and exports a
+// run's trajectories and tracks as files (KITTI / TUM formats).
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include "dlslot/input_error.hpp"
+#include "dlslot/kitti.hpp"
+#include "dlslot/node.hpp"
+#include "evaluation.hpp"
+#include "export.hpp"
+#include "metrics_report.hpp"
+#include "plots.hpp"
+#include "run_log.hpp"
+
+using namespace dlslot;
+using namespace dlslot::eval;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Options {
+  std::string config = "config/dlslot.yaml";
+  std::string log, kitti_root, sequence, calib;
+  std::string traj, traj_format = "kitti", traj_name = "result";
+  std::string gt_poses, gt_format = "kitti";
+  std::string tracks;
+  std::string out, export_dir;
+  std::string classes;
+  double match_distance = 2.0, min_iou = 0.25, dynamic_speed = 0.5, frame_period = 0.1;
+  int track_max_unseen = 0;
+  bool allow_missing_truth = false, quiet = false;
+};
+
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream is(s);
+  for (std::string item; std::getline(is, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+Channels readChannels(const std::string& config) {
+  Channels channels;
+  // The default config is optional (the built-in channel names are the shipped ones); a config
+  // given explicitly must exist.
+  if (config == Options().config && !fs::exists(config)) return channels;
+  ConfigSection root = loadConfig(config);
+  channels.read(root.section("channels"));
+  return channels;
+}
+
+// Ground truth and calibration from the data set's own files.
+struct DataSet {
+  std::optional<kitti::Calib> calib;
+  std::optional<Trajectory> poses;
+  std::optional<std::vector<FrameTracks>> labels, dontcare;
+  std::vector<double> stamps;
+  int num_frames = 0;
+};
+
+DataSet readDataSet(const Options& o) {
+  DataSet d;
+  if (!o.kitti_root.empty()) {
+    if (o.sequence.empty()) throw std::invalid_argument("--kitti needs --sequence");
+    const kitti::SequenceReader reader(o.kitti_root, o.sequence, {}, -1e300, o.frame_period);
+    const kitti::SequencePaths& p = reader.paths();
+    d.calib = reader.calib();
+    d.num_frames = reader.size();
+    const std::vector<double> times = p.times.empty() ? std::vector<double>() : kitti::readTimes(p.times);
+    for (int i = 0; i < d.num_frames; ++i) d.stamps.push_back(times.empty() ? i * o.frame_period : times[i]);
+    if (reader.hasGroundTruthPoses()) {
+      Trajectory t;
+      for (int i = 0; i < d.num_frames; ++i) t.add(i, d.stamps[i], reader.groundTruthPoses()[i]);
+      d.poses = t;
+    }
+    if (!p.labels.empty()) {
+      d.dontcare.emplace();
+      d.labels = readKittiTracks(p.labels, *d.calib, d.num_frames, &*d.dontcare);
+    }
+  }
+  if (!o.calib.empty()) d.calib = kitti::readCalib(o.calib);
+  return d;
+}
+
+std::optional<Pose> camFromVelo(const DataSet& d) {
+  return d.calib ? std::optional<Pose>(d.calib->T_cam_velo) : std::nullopt;
+}
+
+// The per-scan tracking input: labels, ignore regions and tracks of every labelled frame the run covers.
+std::vector<TrackingFrame> trackingFrames(const std::map<int, RunLog::Labels>& labels,
+                                          const std::map<int, RunLog::Tracks>& tracks, const std::set<int>& run_frames,
+                                          const std::optional<Trajectory>& truth,
+                                          const std::map<int, Pose>& ego_poses) {
+  std::map<int, Pose> truth_pose;
+  if (truth)
+    for (size_t i = 0; i < truth->size(); ++i) truth_pose[truth->frames[i]] = truth->poses[i];
+  std::vector<TrackingFrame> frames;
+  for (const auto& [frame, l] : labels) {
+    if (!run_frames.count(frame)) continue;
+    TrackingFrame f;
+    f.frame = frame;
+    f.stamp = l.stamp;
+    for (const Box& b : l.boxes) f.truth.push_back({b, std::nullopt, false});
+    f.ignore = l.dontcare;
+    if (const auto t = tracks.find(frame); t != tracks.end()) f.tracks = t->second.objects;
+    if (const auto p = truth_pose.find(frame); p != truth_pose.end()) f.truth_pose = p->second;
+    if (const auto p = ego_poses.find(frame); p != ego_poses.end()) f.ego_pose = p->second;
+    frames.push_back(std::move(f));
+  }
+  return frames;
+}
+
+std::map<int, RunLog::Labels> labelsByFrame(const std::vector<FrameTracks>& labels,
+                                            const std::vector<FrameTracks>& dontcare, const std::vector<double>& stamps) {
+  std::map<int, RunLog::Labels> out;
+  for (size_t i = 0; i < labels.size(); ++i) out[labels[i].frame] = {stamps.at(i), labels[i].boxes, dontcare[i].boxes};
+  return out;
+}
+
+void requireSameLength(const Trajectory& est, const std::string& est_file, const Trajectory& gt, const std::string& gt_what) {
+  if (est.size() != gt.size())
+    throw InputError(est_file, 0, "has " + std::to_string(est.size()) + " poses but the ground truth (" + gt_what +
+                                      ") has " + std::to_string(gt.size()) + ": trajectories of different lengths");
+}
+
+void exportRun(const std::string& dir, const RunLog* log, const RunData& run, const DataSet& data) {
+  fs::create_directories(dir);
+  const std::optional<Pose> Tr = camFromVelo(data);
+  for (const auto& [name, t] : run.sources) {
+    writeTrajectory((fs::path(dir) / ("trajectory_" + name + "_kitti.txt")).string(), t, TrajectoryFormat::Kitti);
+    writeTrajectory((fs::path(dir) / ("trajectory_" + name + "_tum.txt")).string(), t, TrajectoryFormat::Tum);
+    if (Tr)
+      writeTrajectory((fs::path(dir) / ("trajectory_" + name + "_kitti_cam.txt")).string(), t,
+                      TrajectoryFormat::KittiCam, Tr);
+  }
+  if (!Tr) std::cerr << "dlslot-eval: no calibration (--kitti or --calib): kitti_cam trajectories and tracks not exported\n";
+  if (log && !log->tracks.empty() && data.calib) {
+    std::vector<FrameTracks> frames;
+    for (const auto& [frame, t] : log->tracks) {
+      FrameTracks f{frame, {}};
+      for (const Object& o : t.objects) f.boxes.push_back(o.box);
+      frames.push_back(std::move(f));
+    }
+    writeKittiTracks((fs::path(dir) / "tracks_kitti.txt").string(), frames, *data.calib);
+  }
+}
+
+void addProcessNotes(const RunLog& log, RunData& run) {
+  for (const auto& [name, s] : log.last_status) {
+    std::ostringstream n;
+    n << "process " << name << ": " << s.frames_handled << " frames, " << s.decode_errors << " decode errors, "
+      << s.frame_gaps << " frame gaps, " << s.timeouts << " timeouts, " << s.errors << " errors"
+      << (s.last_warning.empty() ? "" : "; last warning: " + s.last_warning);
+    run.notes.push_back(n.str());
+  }
+}
+
+int run(int argc, char** argv) {
+  Options o;
+  CommandLine cl("dlslot-eval",
+                 "Evaluates a recorded run (--log) or result files (--traj, --tracks) against ground truth; writes "
+                 "metrics.json, report.md and plots (--out) and exports trajectories and tracks (--export).");
+  cl.option("--config", &o.config, "config file, for the channel names (default config/dlslot.yaml)");
+  cl.option("--log", &o.log, "recorded run (lcm-logger file)");
+  cl.option("--kitti", &o.kitti_root, "data set root (KITTI tracking or odometry layout): ground truth and calibration");
+  cl.option("--sequence", &o.sequence, "sequence name, e.g. 0000");
+  cl.option("--calib", &o.calib, "calibration file (instead of --kitti) for kitti_cam files and tracks");
+  cl.option("--traj", &o.traj, "estimated trajectory file");
+  cl.option("--traj-format", &o.traj_format, "kitti (lidar 3x4), kitti_cam (camera-0 3x4) or tum (default kitti)");
+  cl.option("--traj-name", &o.traj_name, "source name of --traj in the report (default result)");
+  cl.option("--gt-poses", &o.gt_poses, "ground-truth trajectory file (default: from --kitti or the log)");
+  cl.option("--gt-format", &o.gt_format, "format of --gt-poses (default kitti)");
+  cl.option("--tracks", &o.tracks, "tracks in the KITTI tracking result format (needs --kitti for labels and calib)");
+  cl.option("--out", &o.out, "write DIR/metrics.json, DIR/report.md, DIR/plots/*.png");
+  cl.option("--export", &o.export_dir, "write DIR/trajectory_<source>_<format>.txt and DIR/tracks_kitti.txt");
+  cl.option("--classes", &o.classes, "evaluated classes, comma-separated (default: all)");
+  cl.option("--match-distance", &o.match_distance, "centre-distance gate in metres (default 2)");
+  cl.option("--min-iou", &o.min_iou, "3D IoU gate of the second line (default 0.25)");
+  cl.option("--dynamic-speed", &o.dynamic_speed, "labels at least this fast (m/s) are dynamic (default 0.5)");
+  cl.option("--track-max-unseen", &o.track_max_unseen,
+            "SLOT_STATE tracks not observed for more frames than this are not output (default 0)");
+  cl.option("--frame-period", &o.frame_period, "seconds per scan for files without timestamps (default 0.1)");
+  cl.flag("--allow-missing-truth", &o.allow_missing_truth, "report timing alone when there is no ground truth");
+  cl.flag("--quiet", &o.quiet, "no summary on stdout");
+  if (!cl.parse(argc, argv)) return 0;
+  if (o.log.empty() && o.traj.empty() && o.tracks.empty())
+    throw std::invalid_argument("nothing to evaluate: give --log RUN.lcmlog, --traj FILE or --tracks FILE\n" + cl.usage());
+  if (!o.tracks.empty() && o.kitti_root.empty())
+    throw std::invalid_argument("--tracks needs --kitti ROOT --sequence S (labels and calibration)");
+
+  const Channels channels = readChannels(o.config);
+  const DataSet data = readDataSet(o);
+  RunData run;
+  std::optional<RunLog> log;
+  std::set<int> run_frames;
+  std::map<int, RunLog::Labels> labels;
+  std::map<int, RunLog::Tracks> tracks;
+  std::map<int, Pose> ego_poses;  // the system's own pose per frame, for the tracks
+
+  if (!o.log.empty()) {
+    log = readRunLog(o.log, channels, o.track_max_unseen);
+    run.sources = log->sources;
+    if (!log->truth.empty()) run.truth = log->truth;
+    labels = log->labels;
+    tracks = log->tracks;
+    run_frames = log->frames;
+    run.has_tracks = log->frame_counts[channels.slot_state] > 0;
+    run.track_velocities_given = true;
+    for (const auto& [frame, t] : tracks) ego_poses[frame] = t.ego;
+    run.timing_ms = log->timing_ms;
+    run.frame_counts = log->frame_counts;
+    addProcessNotes(*log, run);
+  }
+  // Data-set files win over what the log carried.
+  if (data.poses) run.truth = data.poses;
+  if (data.labels) labels = labelsByFrame(*data.labels, *data.dontcare, data.stamps);
+  if (!o.gt_poses.empty())
+    run.truth = readTrajectory(o.gt_poses, parseTrajectoryFormat(o.gt_format), camFromVelo(data), o.frame_period);
+
+  if (!o.traj.empty()) {
+    Trajectory t = readTrajectory(o.traj, parseTrajectoryFormat(o.traj_format), camFromVelo(data), o.frame_period);
+    if (run.truth) requireSameLength(t, o.traj, *run.truth, o.gt_poses.empty() ? "the data set's poses" : o.gt_poses);
+    if (o.log.empty())
+      for (size_t i = 0; i < t.size(); ++i) ego_poses[t.frames[i]] = t.poses[i];
+    run.sources[o.traj_name] = std::move(t);
+  }
+  if (!o.tracks.empty()) {
+    for (const FrameTracks& f : readKittiTracks(o.tracks, *data.calib, data.num_frames)) {
+      RunLog::Tracks& t = tracks[f.frame];
+      t.stamp = data.stamps.at(f.frame);
+      t.objects.clear();
+      for (const Box& b : f.boxes) t.objects.push_back({b, std::nullopt, false});
+    }
+    run.has_tracks = true;
+    run.track_velocities_given = false;
+    for (int i = 0; i < data.num_frames; ++i) run_frames.insert(i);
+  }
+
+  run.has_labels = !labels.empty();
+  run.tracking = trackingFrames(labels, tracks, run_frames, run.truth, ego_poses);
+  if (!run.truth && !run.has_labels) {
+    const std::string what =
+        "no ground truth: " + std::string(o.log.empty() ? "" : "the log has no GROUND_TRUTH messages; ") +
+        "give --kitti ROOT --sequence S or --gt-poses FILE";
+    if (o.log.empty() || !o.allow_missing_truth)
+      throw InputError(o.log.empty() ? (o.traj.empty() ? o.tracks : o.traj) : o.log, 0,
+                       what + (o.log.empty() ? "" : " (or --allow-missing-truth to report timing alone)"));
+    std::cerr << "dlslot-eval: " << what << "; ego and tracking metrics are null\n";
+  }
+
+  if (!o.export_dir.empty()) exportRun(o.export_dir, log ? &*log : nullptr, run, data);
+
+  EvalOptions opt;
+  opt.distance.max_distance_m = o.match_distance;
+  opt.iou.min_iou = o.min_iou;
+  opt.dynamic_speed_mps = o.dynamic_speed;
+  opt.classes = splitList(o.classes);
+  const std::map<std::string, Trajectory> sources = run.sources;
+  const std::optional<Trajectory> truth = run.truth;
+  const Metrics metrics = evaluate(std::move(run), opt);
+
+  if (!o.out.empty()) {
+    const fs::path out(o.out);
+    fs::create_directories(out / "plots");
+    std::vector<std::string> plots;
+    if (!sources.empty()) {
+      plotTrajectories((out / "plots" / "trajectories.png").string(), sources, truth);
+      plots.push_back("plots/trajectories.png");
+      if (truth) {
+        plotErrorOverDistance((out / "plots" / "error_over_distance.png").string(), sources, *truth);
+        plots.push_back("plots/error_over_distance.png");
+      }
+    }
+    writeMetricsJson((out / "metrics.json").string(), metrics);
+    writeReport((out / "report.md").string(), metrics, plots);
+  }
+  if (!o.quiet) printSummary(std::cout, metrics);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return runMain("dlslot-eval", [&] { return run(argc, argv); }); }

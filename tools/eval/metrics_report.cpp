@@ -1,0 +1,254 @@
+#include "metrics_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+#include "dlslot/input_error.hpp"
+
+namespace dlslot::eval {
+namespace {
+
+using Opt = std::optional<double>;
+
+std::string num(Opt v, const char* fmt = "%.9g") {
+  if (!v || !std::isfinite(*v)) return "null";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, *v);
+  return buf;
+}
+
+std::string cell(Opt v, const char* fmt) { return v && std::isfinite(*v) ? num(v, fmt) : "-"; }
+
+std::string quoted(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) continue;
+    out += c;
+  }
+  return out + "\"";
+}
+
+// The ego keys, in the order the issue lists them, with their value in EgoMetrics.
+const std::vector<std::pair<std::string, std::function<Opt(const EgoMetrics&)>>>& egoKeys() {
+  static const std::vector<std::pair<std::string, std::function<Opt(const EgoMetrics&)>>> keys = {
+      {"ate_rmse_m", [](const EgoMetrics& e) { return e.ate_rmse_m; }},
+      {"rpe1_t_m", [](const EgoMetrics& e) { return e.rpe1_t_m; }},
+      {"rpe1_r_deg", [](const EgoMetrics& e) { return e.rpe1_r_deg; }},
+      {"rpe10_t_m", [](const EgoMetrics& e) { return e.rpe10_t_m; }},
+      {"rpe10_r_deg", [](const EgoMetrics& e) { return e.rpe10_r_deg; }},
+      {"t_rel_pct", [](const EgoMetrics& e) { return e.t_rel_pct; }},
+      {"r_rel_deg_per_100m", [](const EgoMetrics& e) { return e.r_rel_deg_per_100m; }},
+      {"t_rel_short_pct", [](const EgoMetrics& e) { return e.t_rel_short_pct; }},
+      {"r_rel_short_deg_per_100m", [](const EgoMetrics& e) { return e.r_rel_short_deg_per_100m; }},
+  };
+  return keys;
+}
+
+std::vector<std::pair<std::string, Opt>> trackingValues(const std::optional<TrackingMetrics>& t) {
+  const auto count = [&](int ClearMot::*field) -> Opt {
+    return t ? Opt(static_cast<double>(t->clear.*field)) : std::nullopt;
+  };
+  return {{"mota", t ? t->clear.mota : std::nullopt},
+          {"motp_m", t ? t->clear.motp_m : std::nullopt},
+          {"idsw", count(&ClearMot::idsw)},
+          {"fp", count(&ClearMot::fp)},
+          {"fn", count(&ClearMot::fn)},
+          {"hota", t && t->hota ? Opt(t->hota->hota) : std::nullopt},
+          {"velocity_rmse_mps", t ? t->clear.velocity_rmse_mps : std::nullopt}};
+}
+
+// A table rendered as Markdown with padded columns, so it reads well in a terminal too.
+class Table {
+ public:
+  explicit Table(std::vector<std::string> header) : rows_{std::move(header)} {}
+  void row(std::vector<std::string> cells) { rows_.push_back(std::move(cells)); }
+  bool empty() const { return rows_.size() == 1; }
+  std::string render() const {
+    std::vector<size_t> width(rows_[0].size(), 3);
+    for (const auto& r : rows_)
+      for (size_t c = 0; c < r.size(); ++c) width[c] = std::max(width[c], r[c].size());
+    std::ostringstream out;
+    for (size_t i = 0; i < rows_.size(); ++i) {
+      out << "|";
+      for (size_t c = 0; c < width.size(); ++c) {
+        const std::string& s = c < rows_[i].size() ? rows_[i][c] : std::string();
+        out << " " << s << std::string(width[c] - s.size(), ' ') << " |";
+      }
+      out << "\n";
+      if (i == 0) {
+        out << "|";
+        for (size_t w : width) out << std::string(w + 2, '-') << "|";
+        out << "\n";
+      }
+    }
+    return out.str();
+  }
+
+ private:
+  std::vector<std::vector<std::string>> rows_;
+};
+
+Table egoTable(const Metrics& m) {
+  Table t({"source", "frames", "path m", "ATE m", "ATE unaligned m", "RPE1 t m", "RPE1 r deg", "RPE10 t m",
+           "RPE10 r deg", "t_rel %", "r_rel deg/100m", "t_rel 10-80m %", "r_rel 10-80m deg/100m"});
+  for (const auto& [name, e] : m.ego) {
+    const std::string label = name + (name == m.primary_source ? " (primary)" : "");
+    if (!e) {
+      t.row({label, "-", "-", "no ground truth"});
+      continue;
+    }
+    t.row({label, std::to_string(e->frames), cell(e->path_length_m, "%.1f"), cell(e->ate_rmse_m, "%.3f"),
+           cell(e->ate_unaligned_rmse_m, "%.3f"), cell(e->rpe1_t_m, "%.4f"), cell(e->rpe1_r_deg, "%.4f"),
+           cell(e->rpe10_t_m, "%.3f"), cell(e->rpe10_r_deg, "%.3f"), cell(e->t_rel_pct, "%.3f"),
+           cell(e->r_rel_deg_per_100m, "%.4f"), cell(e->t_rel_short_pct, "%.3f"),
+           cell(e->r_rel_short_deg_per_100m, "%.4f")});
+  }
+  return t;
+}
+
+Table trackingTable(const Metrics& m) {
+  Table t({"matching", "MOTA", "MOTP m", "IDSW", "FP", "FN", "TP", "labels", "HOTA", "DetA", "AssA", "LocA",
+           "velocity RMSE m/s", "velocity pairs"});
+  for (const auto* tm : {&m.tracking, &m.tracking_iou}) {
+    if (!*tm) continue;
+    const ClearMot& c = (*tm)->clear;
+    const std::optional<Hota>& h = (*tm)->hota;
+    t.row({(*tm)->criterion.describe(), cell(c.mota, "%.4f"), cell(c.motp_m, "%.3f"), std::to_string(c.idsw),
+           std::to_string(c.fp), std::to_string(c.fn), std::to_string(c.tp), std::to_string(c.num_truth),
+           cell(h ? Opt(h->hota) : std::nullopt, "%.4f"), cell(h ? Opt(h->deta) : std::nullopt, "%.4f"),
+           cell(h ? Opt(h->assa) : std::nullopt, "%.4f"), cell(h ? Opt(h->loca) : std::nullopt, "%.4f"),
+           cell(c.velocity_rmse_mps, "%.3f"), std::to_string(c.velocity_pairs)});
+  }
+  return t;
+}
+
+Table timingTable(const Metrics& m) {
+  Table t({"module", "frames", "mean ms", "p95 ms", "max ms"});
+  for (const auto& [module, s] : m.timing_ms)
+    t.row({module, std::to_string(s.count()), cell(s.mean(), "%.2f"), cell(s.percentile(95), "%.2f"),
+           cell(s.max(), "%.2f")});
+  return t;
+}
+
+void writeText(const std::string& path, const std::string& text) {
+  std::ofstream out(path);
+  if (!out) throw InputError(path, 0, "cannot open for writing");
+  out << text;
+  if (!out) throw InputError(path, 0, "write failed");
+}
+
+}  // namespace
+
+std::string metricsJson(const Metrics& m) {
+  std::vector<std::pair<std::string, std::string>> kv;
+  const auto ego_entries = [&](const std::string& prefix, const std::optional<EgoMetrics>& e) {
+    for (const auto& [key, get] : egoKeys()) kv.emplace_back(prefix + key, num(e ? get(*e) : std::nullopt));
+  };
+  const auto primary = m.ego.find(m.primary_source);
+  kv.emplace_back("ego.source", m.primary_source.empty() ? "null" : quoted(m.primary_source));
+  ego_entries("ego.", primary != m.ego.end() ? primary->second : std::nullopt);
+  for (const auto& [name, e] : m.ego) ego_entries("sources." + name + ".", e);
+  for (const auto& [key, v] : trackingValues(m.tracking)) kv.emplace_back("tracking." + key, num(v));
+  for (const auto& [key, v] : trackingValues(m.tracking_iou)) kv.emplace_back("tracking_iou." + key, num(v));
+  for (const auto& [module, s] : m.timing_ms) {
+    kv.emplace_back("timing_ms." + module + ".mean", num(s.count() ? Opt(s.mean()) : std::nullopt));
+    kv.emplace_back("timing_ms." + module + ".p95", num(s.count() ? Opt(s.percentile(95)) : std::nullopt));
+  }
+  for (const auto& [channel, n] : m.frame_counts) kv.emplace_back("frames." + channel, std::to_string(n));
+  std::string out = "{\n";
+  for (size_t i = 0; i < kv.size(); ++i)
+    out += "  " + quoted(kv[i].first) + ": " + kv[i].second + (i + 1 < kv.size() ? ",\n" : "\n");
+  return out + "}\n";
+}
+
+void writeMetricsJson(const std::string& path, const Metrics& m) { writeText(path, metricsJson(m)); }
+
+std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plots) {
+  std::ostringstream out;
+  out << "# DL-SLOT evaluation\n\n" << summaryLine(m) << "\n\n";
+  out << "## Ego motion\n\n";
+  if (m.ego.empty()) {
+    out << "No ego trajectory in the input.\n\n";
+  } else {
+    out << egoTable(m).render() << "\n"
+        << "ATE: RMSE of the position after SE(3) Umeyama alignment (unaligned: both start at the first scan's "
+           "lidar frame). RPE: RMSE over frame pairs 1 and 10 scans apart. t_rel / r_rel: KITTI devkit segments "
+           "of 100..800 m starting every 10 frames (and 10..80 m), poses in the lidar frame.\n\n";
+  }
+  out << "## Tracking (bird's-eye view, each scan's lidar frame)\n\n";
+  if (!m.tracking) {
+    out << "Not measurable: the input has no labels or no tracks.\n\n";
+  } else {
+    out << trackingTable(m).render() << "\n"
+        << "Tracks (world frame) are moved into each scan's lidar frame with the system's own ego pose. Classes "
+           "match as in the KITTI devkit (Car~Van, Pedestrian~Person_sitting); tracks in DontCare regions count "
+           "neither as false nor as true positives. HOTA: mean over alpha = 0.05..0.95; similarity = 3D IoU for "
+           "the IoU line, max(0, 1 - d / "
+        << num(m.tracking->criterion.max_distance_m, "%g") << " m) of the centre distance d for the distance line.\n\n"
+        << "Velocities: " << m.velocity_frame << ".\n\n";
+  }
+  out << "## Timing (per frame)\n\n";
+  if (m.timing_ms.empty())
+    out << "No timings in the input.\n\n";
+  else
+    out << timingTable(m).render() << "\n";
+  if (!m.frame_counts.empty()) {
+    out << "## Messages in the log\n\n";
+    Table t({"channel", "messages"});
+    for (const auto& [channel, n] : m.frame_counts) t.row({channel, std::to_string(n)});
+    out << t.render() << "\n";
+  }
+  if (!m.notes.empty()) {
+    out << "## Notes\n\n";
+    for (const std::string& n : m.notes) out << "- " << n << "\n";
+    out << "\n";
+  }
+  if (!plots.empty()) {
+    out << "## Plots\n\n";
+    for (const std::string& p : plots) out << "![" << p << "](" << p << ")\n\n";
+  }
+  return out.str();
+}
+
+void writeReport(const std::string& path, const Metrics& m, const std::vector<std::string>& plots) {
+  writeText(path, reportMarkdown(m, plots));
+}
+
+std::string summaryLine(const Metrics& m) {
+  std::ostringstream out;
+  out << "eval:";
+  const auto primary = m.ego.find(m.primary_source);
+  if (primary == m.ego.end())
+    out << " no ego trajectory";
+  else if (!primary->second)
+    out << " " << m.primary_source << " (no ground truth)";
+  else
+    out << " " << m.primary_source << " ATE " << cell(primary->second->ate_rmse_m, "%.3f") << " m, t_rel "
+        << cell(primary->second->t_rel_pct ? primary->second->t_rel_pct : primary->second->t_rel_short_pct, "%.2f")
+        << (primary->second->t_rel_pct ? " %" : " % (10-80 m)");
+  if (m.tracking)
+    out << "; MOTA " << cell(m.tracking->clear.mota, "%.3f") << ", HOTA "
+        << cell(m.tracking->hota ? Opt(m.tracking->hota->hota) : std::nullopt, "%.3f") << ", IDSW "
+        << m.tracking->clear.idsw;
+  else
+    out << "; no tracking evaluation";
+  for (const char* module : {"odometry", "tracker", "backend"}) {
+    const auto it = m.timing_ms.find(module);
+    if (it != m.timing_ms.end()) out << "; " << module << " " << cell(it->second.mean(), "%.1f") << " ms";
+  }
+  return out.str();
+}
+
+void printSummary(std::ostream& out, const Metrics& m) {
+  out << summaryLine(m) << "\n";
+  if (!m.ego.empty()) out << "\n" << egoTable(m).render();
+  if (m.tracking) out << "\n" << trackingTable(m).render();
+  if (!m.timing_ms.empty()) out << "\n" << timingTable(m).render();
+}
+
+}  // namespace dlslot::eval

@@ -1,0 +1,155 @@
+#include "plots.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+#include "dlslot/input_error.hpp"
+#include "ego_metrics.hpp"
+
+namespace dlslot::eval {
+namespace {
+
+using Series = std::vector<Eigen::Vector2d>;
+
+const cv::Scalar kTruthColour(0, 0, 0);
+const std::vector<cv::Scalar> kColours = {{200, 90, 30}, {40, 40, 220}, {40, 160, 40}, {180, 40, 180}, {0, 140, 230}};
+
+// A data-to-pixel mapping with axes, ticks and a legend.
+class Plot {
+ public:
+  Plot(Eigen::Vector2d lo, Eigen::Vector2d hi, bool equal_scale) : image_(kHeight, kWidth, CV_8UC3, cv::Scalar(255, 255, 255)) {
+    for (int k = 0; k < 2; ++k)
+      if (!(hi[k] - lo[k] > 1e-9)) {  // a flat range still gets some extent
+        lo[k] -= 1.0;
+        hi[k] += 1.0;
+      }
+    const Eigen::Vector2d pad = 0.04 * (hi - lo);
+    lo -= pad;
+    hi += pad;
+    const Eigen::Vector2d pixels(kWidth - kLeft - kRight, kHeight - kTop - kBottom);
+    scale_ = pixels.cwiseQuotient(hi - lo);
+    if (equal_scale) {  // same metres per pixel on both axes, data centred
+      const double s = scale_.minCoeff();
+      const Eigen::Vector2d centre = 0.5 * (lo + hi), half = 0.5 * pixels / s;
+      lo = centre - half;
+      hi = centre + half;
+      scale_.setConstant(s);
+    }
+    lo_ = lo;
+    hi_ = hi;
+  }
+
+  cv::Point toPixel(const Eigen::Vector2d& p) const {
+    return {static_cast<int>(std::lround(kLeft + (p.x() - lo_.x()) * scale_.x())),
+            static_cast<int>(std::lround(kHeight - kBottom - (p.y() - lo_.y()) * scale_.y()))};
+  }
+
+  void axes(const std::string& x_label, const std::string& y_label, const std::string& title) {
+    const cv::Scalar grid(225, 225, 225), ink(60, 60, 60);
+    for (int k = 0; k < 2; ++k) {
+      const double step = tickStep(hi_[k] - lo_[k]);
+      for (double v = std::ceil(lo_[k] / step) * step; v <= hi_[k]; v += step) {
+        Eigen::Vector2d a = lo_, b = hi_;
+        a[k] = b[k] = v;
+        cv::line(image_, toPixel(a), toPixel(b), grid, 1);
+        char text[32];
+        std::snprintf(text, sizeof text, "%g", std::abs(v) < 1e-9 * step ? 0.0 : v);
+        const cv::Point at = toPixel(a);
+        if (k == 0)
+          cv::putText(image_, text, {at.x - 12, kHeight - kBottom + 18}, cv::FONT_HERSHEY_SIMPLEX, 0.4, ink, 1, cv::LINE_AA);
+        else
+          cv::putText(image_, text, {8, at.y + 4}, cv::FONT_HERSHEY_SIMPLEX, 0.4, ink, 1, cv::LINE_AA);
+      }
+    }
+    cv::rectangle(image_, {kLeft, kTop}, {kWidth - kRight, kHeight - kBottom}, ink, 1);
+    cv::putText(image_, x_label, {kWidth / 2 - 40, kHeight - 12}, cv::FONT_HERSHEY_SIMPLEX, 0.5, ink, 1, cv::LINE_AA);
+    cv::putText(image_, y_label, {8, kTop - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.5, ink, 1, cv::LINE_AA);
+    cv::putText(image_, title, {kLeft + 150, kTop - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.55, ink, 1, cv::LINE_AA);
+  }
+
+  void line(const Series& s, const cv::Scalar& colour, int thickness, const std::string& name) {
+    std::vector<cv::Point> px;
+    for (const auto& p : s) px.push_back(toPixel(p));
+    cv::polylines(image_, px, false, colour, thickness, cv::LINE_AA);
+    if (!px.empty()) cv::circle(image_, px.front(), 4, colour, cv::FILLED, cv::LINE_AA);
+    legend_.emplace_back(name, colour);
+  }
+
+  void save(const std::string& path) {
+    int y = kTop + 20;
+    for (const auto& [name, colour] : legend_) {
+      cv::line(image_, {kWidth - kRight - 170, y - 4}, {kWidth - kRight - 145, y - 4}, colour, 3, cv::LINE_AA);
+      cv::putText(image_, name, {kWidth - kRight - 138, y}, cv::FONT_HERSHEY_SIMPLEX, 0.45, colour, 1, cv::LINE_AA);
+      y += 20;
+    }
+    if (!cv::imwrite(path, image_)) throw InputError(path, 0, "cannot write the PNG");
+  }
+
+ private:
+  static double tickStep(double range) {
+    const double raw = range / 6.0, p = std::pow(10.0, std::floor(std::log10(raw)));
+    for (double m : {1.0, 2.0, 5.0})
+      if (m * p >= raw) return m * p;
+    return 10.0 * p;
+  }
+  static constexpr int kWidth = 1000, kHeight = 800, kLeft = 70, kRight = 20, kTop = 40, kBottom = 50;
+  cv::Mat image_;
+  Eigen::Vector2d lo_, hi_, scale_;
+  std::vector<std::pair<std::string, cv::Scalar>> legend_;
+};
+
+Series bev(const Trajectory& t) {
+  Series s;
+  for (const Pose& T : t.poses) s.push_back(T.translation().head<2>());
+  return s;
+}
+
+void bounds(const Series& s, Eigen::Vector2d& lo, Eigen::Vector2d& hi) {
+  for (const auto& p : s) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+}
+
+}  // namespace
+
+void plotTrajectories(const std::string& path, const std::map<std::string, Trajectory>& sources,
+                      const std::optional<Trajectory>& truth) {
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(INFINITY), hi = -lo;
+  std::vector<std::pair<std::string, Series>> series;
+  if (truth) series.emplace_back("ground truth", bev(*truth));
+  for (const auto& [name, t] : sources) series.emplace_back(name, bev(t));
+  for (const auto& s : series) bounds(s.second, lo, hi);
+  if (!lo.allFinite()) lo = hi = Eigen::Vector2d::Zero();
+  Plot plot(lo, hi, true);
+  plot.axes("x [m]", "y [m]", "trajectories, bird's-eye view");
+  size_t c = 0;
+  for (const auto& [name, s] : series)
+    plot.line(s, truth && name == "ground truth" ? kTruthColour : kColours[c++ % kColours.size()], 2, name);
+  plot.save(path);
+}
+
+void plotErrorOverDistance(const std::string& path, const std::map<std::string, Trajectory>& sources,
+                           const Trajectory& truth) {
+  Eigen::Vector2d lo(0, 0), hi = lo;
+  std::vector<std::pair<std::string, Series>> series;
+  for (const auto& [name, t] : sources) {
+    const auto [est, gt] = commonFrames(t, truth);
+    if (est.empty()) continue;
+    const std::vector<double> dist = pathDistances(gt), err = alignedPositionErrors(est, gt);
+    Series s;
+    for (size_t i = 0; i < dist.size(); ++i) s.emplace_back(dist[i], err[i]);
+    bounds(s, lo, hi);
+    series.emplace_back(name, std::move(s));
+  }
+  Plot plot(lo, hi, false);
+  plot.axes("distance along ground truth [m]", "position error after alignment [m]", "translation error over distance");
+  size_t c = 0;
+  for (const auto& [name, s] : series) plot.line(s, kColours[c++ % kColours.size()], 2, name);
+  plot.save(path);
+}
+
+}  // namespace dlslot::eval

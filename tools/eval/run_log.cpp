@@ -1,0 +1,169 @@
+#include "run_log.hpp"
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <cstdio>
+#include <filesystem>
+
+#include "dlslot/associations_t.hpp"
+#include "dlslot/convert.hpp"
+#include "dlslot/detections_t.hpp"
+#include "dlslot/ground_truth_t.hpp"
+#include "dlslot/input_error.hpp"
+#include "dlslot/node.hpp"
+#include "dlslot/odometry_t.hpp"
+#include "dlslot/slot_state_t.hpp"
+
+namespace dlslot::eval {
+namespace {
+
+constexpr int64_t kEventHeaderBytes = 4 + 8 + 8 + 4 + 4;  // sync word, event number, timestamp, two lengths
+
+double seconds(int64_t utime) { return utime * 1e-6; }
+
+void addTimings(RunLog& run, const std::string& process, const std::vector<stage_timing_t>& timings) {
+  for (const stage_timing_t& t : timings)
+    run.timing_ms[t.name == "total" ? process : process + "." + t.name].add(t.ms);
+}
+
+// Tracks of the newest frame, moved into its lidar frame with the backend's own ego pose.
+RunLog::Tracks tracksOf(const slot_state_t& msg, int track_max_unseen) {
+  RunLog::Tracks out;
+  out.stamp = seconds(msg.utime);
+  out.ego = fromMsg(msg.ego_pose);
+  const Pose lidar_world = out.ego.inverse();
+  for (const track_t& t : msg.tracks) {
+    if (msg.frame - t.last_seen_frame > track_max_unseen) continue;
+    const Pose T_world_object = fromMsg(t.pose);
+    Box world;
+    world.center = T_world_object.translation();
+    world.yaw = yawOf(T_world_object.linear());
+    world.size = Eigen::Vector3d(t.size[0], t.size[1], t.size[2]);
+    world.type = t.type;
+    world.id = t.id;
+    Object o;
+    o.box = world.transformed(lidar_world);
+    o.velocity = (lidar_world.linear() * Eigen::Vector3d(t.velocity[0], t.velocity[1], t.velocity[2])).head<2>();
+    out.objects.push_back(o);
+  }
+  return out;
+}
+
+class LogReader {
+ public:
+  LogReader(const std::string& path, const Channels& channels, int track_max_unseen)
+      : path_(path), ch_(channels), track_max_unseen_(track_max_unseen) {}
+
+  RunLog read() {
+    std::error_code ec;
+    const auto file_size = std::filesystem::file_size(path_, ec);
+    if (ec) throw InputError(path_, 0, "cannot read the log: " + ec.message());
+    lcm::LogFile log(path_, "r");
+    if (!log.good()) throw InputError(path_, 0, "cannot open the log for reading");
+    for (const std::string* c : {&ch_.scan, &ch_.detections, &ch_.ground_truth, &ch_.odometry, &ch_.associations,
+                                 &ch_.slot_state})
+      run_.frame_counts[*c] = 0;
+    int64_t end_of_last = 0, count = 0;
+    while (const lcm::LogEvent* ev = log.readNextEvent()) {
+      // LCM resynchronises silently on garbage; an event must start where the previous one ended.
+      const int64_t end = std::ftell(log.getFilePtr());
+      const int64_t start = end - kEventHeaderBytes - static_cast<int64_t>(ev->channel.size()) - ev->datalen;
+      if (start != end_of_last)
+        throw InputError(path_, 0, "corrupt log: " + std::to_string(start - end_of_last) + " unreadable bytes at offset " +
+                                       std::to_string(end_of_last) + " (before event " + std::to_string(count) + ")");
+      end_of_last = end;
+      handle(*ev, count++);
+    }
+    if (end_of_last != static_cast<int64_t>(file_size))
+      throw InputError(path_, 0, "truncated or corrupt log: bytes " + std::to_string(end_of_last) + ".." +
+                                     std::to_string(file_size) + " after event " + std::to_string(count) +
+                                     " do not form a complete event");
+    if (count == 0) throw InputError(path_, 0, "the log holds no events");
+    finishSlot();
+    return std::move(run_);
+  }
+
+ private:
+  template <class Msg>
+  Msg decode(const lcm::LogEvent& ev, int64_t index, const char* type) {
+    Msg msg;
+    if (msg.decode(ev.data, 0, ev.datalen) < 0)
+      throw InputError(path_, 0, "event " + std::to_string(index) + " on channel " + ev.channel +
+                                     " does not decode as dlslot." + type + " (corrupt log or wrong message type)");
+    return msg;
+  }
+
+  void handle(const lcm::LogEvent& ev, int64_t index) {
+    const std::string& c = ev.channel;
+    if (run_.frame_counts.count(c)) ++run_.frame_counts[c];
+    if (c == ch_.odometry) {
+      const auto m = decode<odometry_t>(ev, index, "odometry_t");
+      odometry_[m.frame] = {seconds(m.utime), fromMsg(m.pose)};
+      addTimings(run_, "odometry", m.timings);
+      run_.frames.insert(m.frame);
+    } else if (c == ch_.slot_state) {
+      const auto m = decode<slot_state_t>(ev, index, "slot_state_t");
+      slot_[m.frame] = {seconds(m.utime), fromMsg(m.ego_pose)};
+      if (m.has_smoothed) smoothed_[m.smoothed_frame] = {seconds(m.smoothed_utime), fromMsg(m.smoothed_pose)};
+      run_.tracks[m.frame] = tracksOf(m, track_max_unseen_);
+      addTimings(run_, "backend", m.timings);
+      run_.frames.insert(m.frame);
+    } else if (c == ch_.associations) {
+      const auto m = decode<associations_t>(ev, index, "associations_t");
+      addTimings(run_, "tracker", m.timings);
+      run_.frames.insert(m.frame);
+    } else if (c == ch_.ground_truth) {
+      const auto m = decode<ground_truth_t>(ev, index, "ground_truth_t");
+      if (m.has_pose) truth_[m.frame] = {seconds(m.utime), fromMsg(m.pose)};
+      RunLog::Labels& l = run_.labels[m.frame];
+      l.stamp = seconds(m.utime);
+      l.boxes = fromMsg(m.boxes);
+      l.dontcare.clear();
+      for (const box_t& b : m.dontcare)  // DontCare without a 3D extent cannot be matched in 3D
+        if (b.size[0] > 0 && b.size[1] > 0 && b.size[2] > 0) l.dontcare.push_back(fromMsg(b));
+      run_.frames.insert(m.frame);
+    } else if (c == ch_.scan) {  // not decoded: only its frame index is needed
+      const int frame = frameOfEncoded(ev.data, ev.datalen);
+      if (frame < 0) throw InputError(path_, 0, "event " + std::to_string(index) + " on channel " + c + " is too short");
+      run_.frames.insert(frame);
+    } else if (c == ch_.detections) {
+      run_.frames.insert(decode<detections_t>(ev, index, "detections_t").frame);
+    } else if (c == ch_.status) {
+      const auto m = decode<process_status_t>(ev, index, "process_status_t");
+      run_.last_status[m.name] = m;
+    }
+  }
+
+  static Trajectory toTrajectory(const std::map<int, std::pair<double, Pose>>& poses) {
+    Trajectory t;
+    for (const auto& [frame, sp] : poses) t.add(frame, sp.first, sp.second);
+    return t;
+  }
+
+  void finishSlot() {
+    if (!odometry_.empty()) run_.sources["odometry"] = toTrajectory(odometry_);
+    if (!slot_.empty()) run_.sources["slot"] = toTrajectory(slot_);
+    // Final poses of the frames that left the window; the newest frames never left it, so they
+    // keep their latest estimate.
+    if (!smoothed_.empty()) {
+      std::map<int, std::pair<double, Pose>> s = slot_;
+      for (const auto& [frame, sp] : smoothed_) s[frame] = sp;
+      run_.sources["slot_smoothed"] = toTrajectory(s);
+    }
+    run_.truth = toTrajectory(truth_);
+  }
+
+  std::string path_;
+  Channels ch_;
+  int track_max_unseen_;
+  RunLog run_;
+  std::map<int, std::pair<double, Pose>> odometry_, slot_, smoothed_, truth_;
+};
+
+}  // namespace
+
+RunLog readRunLog(const std::string& path, const Channels& channels, int track_max_unseen) {
+  return LogReader(path, channels, track_max_unseen).read();
+}
+
+}  // namespace dlslot::eval

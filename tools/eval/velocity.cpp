@@ -1,0 +1,54 @@
+#include "velocity.hpp"
+
+#include <map>
+#include <stdexcept>
+
+namespace dlslot::eval {
+namespace {
+
+std::vector<Object>& objects(TrackingFrame& f, Side side) { return side == Side::Truth ? f.truth : f.tracks; }
+
+const std::optional<Pose>& poseOf(const TrackingFrame& f, Side side) {
+  return side == Side::Truth ? f.truth_pose : f.ego_pose;
+}
+
+}  // namespace
+
+void finiteDifferenceVelocities(std::vector<TrackingFrame>& frames, Side side, VelocityFrame velocity_frame,
+                                bool overwrite) {
+  const bool world = velocity_frame == VelocityFrame::World;
+  // Position of every object by frame and id, in the frame the differences are taken in.
+  std::vector<std::map<int, Eigen::Vector3d>> positions(frames.size());
+  for (size_t t = 0; t < frames.size(); ++t) {
+    const std::optional<Pose>& pose = poseOf(frames[t], side);
+    if (world && !pose)
+      throw std::invalid_argument("world-frame velocities need a pose for frame " + std::to_string(frames[t].frame));
+    for (const Object& o : objects(frames[t], side))
+      positions[t][o.box.id] = world ? Eigen::Vector3d(*pose * o.box.center) : o.box.center;
+  }
+  for (size_t t = 0; t < frames.size(); ++t) {
+    for (Object& o : objects(frames[t], side)) {
+      if (o.velocity && !overwrite) continue;
+      // The neighbours that saw the same object; a missing side makes it one-sided.
+      size_t a = t, b = t;
+      if (t > 0 && positions[t - 1].count(o.box.id)) a = t - 1;
+      if (t + 1 < frames.size() && positions[t + 1].count(o.box.id)) b = t + 1;
+      const double dt = frames[b].stamp - frames[a].stamp;
+      if (a == b || !(dt > 0)) {
+        o.velocity.reset();
+        continue;
+      }
+      Eigen::Vector3d v = (positions[b].at(o.box.id) - positions[a].at(o.box.id)) / dt;
+      if (world) v = poseOf(frames[t], side)->linear().transpose() * v;
+      o.velocity = v.head<2>();
+    }
+  }
+}
+
+void markDynamicLabels(std::vector<TrackingFrame>& frames, VelocityFrame velocity_frame, double min_speed_mps) {
+  for (TrackingFrame& f : frames)
+    for (Object& o : f.truth)
+      o.dynamic = o.velocity && (velocity_frame == VelocityFrame::Sensor || o.velocity->norm() >= min_speed_mps);
+}
+
+}  // namespace dlslot::eval

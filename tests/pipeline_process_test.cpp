@@ -1,0 +1,176 @@
+// The whole pipeline started for real by dlslot-run on a short simulated sequence, inside a
+// private network namespace (see tests/CMakeLists.txt): completeness, determinism, replay into a
+// fresh backend, and faults.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "dlslot/associations_t.hpp"
+#include "dlslot/odometry_t.hpp"
+#include "dlslot/slot_state_t.hpp"
+#include "process_harness.hpp"
+
+using namespace dlslot;
+using namespace dlslot::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kFrames = 30;
+
+// One simulated sequence for every test of this file (simulated once, into the build tree).
+const std::string& simulatedRoot() {
+  static const std::string root = [] {
+    const std::string dir = binDir() + "/../test-scratch/pipeline-data";
+    if (!fs::exists(dir + "/training/poses/0000.txt")) {
+      fs::remove_all(dir);
+      ChildProcess sim({bin("dlslot-sim"), "--scenario", "intersection", "--frames", std::to_string(kFrames), "--seed",
+                        "3", "--out", dir},
+                       binDir() + "/../test-scratch/pipeline-sim.log");
+      EXPECT_EQ(sim.wait(300), 0) << sim.output();
+    }
+    return dir;
+  }();
+  return root;
+}
+
+std::vector<std::string> runArgs(const std::string& out, std::vector<std::string> extra = {}) {
+  std::vector<std::string> a = {bin("dlslot-run"), "--config", config(), "--kitti", simulatedRoot(),
+                                "--detections", simulatedRoot() + "/detections/sim", "--out", out, "--quiet"};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
+}
+
+// SLOT_STATE without its wall-clock timings, which legitimately differ between runs.
+std::vector<slot_state_t> slotStatesOf(const std::string& log) {
+  auto states = decodeAll<slot_state_t>(readLog(log)["SLOT_STATE"]);
+  for (auto& s : states) {
+    s.timings.clear();
+    s.num_timings = 0;
+  }
+  return states;
+}
+
+std::vector<uint8_t> encoded(slot_state_t s) {
+  std::vector<uint8_t> buf(s.getEncodedSize());
+  s.encode(buf.data(), 0, buf.size());
+  return buf;
+}
+
+}  // namespace
+
+TEST(PipelineProcess, EveryFrameOnEveryChannelAndMetricsWithinBounds) {
+  const std::string out = scratchDir();
+  ChildProcess run(runArgs(out), out + "/../pipeline-run.log");
+  ASSERT_EQ(run.wait(600), 0) << run.output();
+  auto events = readLog(out + "/run.lcmlog");
+  for (const std::string ch : {"LIDAR_SCAN", "DETECTIONS", "GROUND_TRUTH", "ODOMETRY", "ASSOCIATIONS", "SLOT_STATE"})
+    EXPECT_EQ(events[ch].size(), static_cast<size_t>(kFrames)) << ch;
+  const auto states = decodeAll<slot_state_t>(events["SLOT_STATE"]);
+  for (int i = 0; i < static_cast<int>(states.size()); ++i) {
+    EXPECT_EQ(states[i].frame, i);
+    EXPECT_FALSE(states[i].odometry_missing) << i;
+    EXPECT_FALSE(states[i].associations_missing) << i;
+  }
+  EXPECT_GT(states.back().num_tracks, 0);
+  // Every process reported, with no decode errors, gaps or timeouts.
+  const auto status = decodeAll<process_status_t>(events["PROCESS_STATUS"]);
+  std::map<std::string, process_status_t> last;
+  for (const auto& s : status) last[s.name] = s;
+  for (const std::string p : {"player", "odometry", "tracker", "backend", "renderer"}) {
+    ASSERT_TRUE(last.count(p)) << p;
+    EXPECT_EQ(last[p].decode_errors + last[p].frame_gaps + last[p].timeouts, 0) << p << ": " << last[p].last_warning;
+  }
+  // Outputs and metrics.
+  for (const std::string f : {"metrics.json", "report.md", "trajectory_slot_kitti.txt", "trajectory_odometry_kitti.txt",
+                              "trajectory_groundtruth_kitti.txt", "trajectory_slot_tum.txt", "tracks_kitti.txt",
+                              "config.yaml", "bev/000000.png"})
+    EXPECT_TRUE(fs::exists(out + "/" + f)) << f;
+  const YAML::Node m = YAML::LoadFile(out + "/metrics.json");
+  EXPECT_LT(m["ego.ate_rmse_m"].as<double>(), 1.0);
+  EXPECT_GT(m["tracking.mota"].as<double>(), 0.3);
+  EXPECT_EQ(m["frames.SLOT_STATE"].as<int>(), kFrames);
+}
+
+TEST(PipelineProcess, SameRunTwiceGivesIdenticalSlotState) {
+  const std::string out = scratchDir();
+  for (const std::string r : {"a", "b"}) {
+    ChildProcess run(runArgs(out + "/" + r, {"--no-render", "--no-eval"}), out + "/" + r + ".log");
+    ASSERT_EQ(run.wait(600), 0) << run.output();
+  }
+  const auto a = slotStatesOf(out + "/a/run.lcmlog"), b = slotStatesOf(out + "/b/run.lcmlog");
+  ASSERT_EQ(a.size(), static_cast<size_t>(kFrames));
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(encoded(a[i]), encoded(b[i])) << "frame " << i;
+}
+
+TEST(PipelineProcess, ReplayedOdometryAndAssociationsGiveTheSameSlotState) {
+  const std::string out = scratchDir();
+  ChildProcess run(runArgs(out + "/run", {"--no-render", "--no-eval"}), out + "/run.log");
+  ASSERT_EQ(run.wait(600), 0) << run.output();
+
+  ChildProcess logger({"/usr/bin/lcm-logger", "--quiet", "--force", "--channel=SLOT_STATE", out + "/replay.lcmlog"},
+                      out + "/logger.log");
+  ChildProcess backend({bin("dlslot-backend"), "--config", config(), "--mode", "slot"}, out + "/backend.log");
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  ChildProcess player({"/usr/bin/lcm-logplayer", "--speed=1", "--regexp=^(ODOMETRY|ASSOCIATIONS)$",
+                       out + "/run/run.lcmlog"},
+                      out + "/logplayer.log");
+  ASSERT_EQ(player.wait(120), 0) << player.output();
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  EXPECT_EQ(backend.stop(), 0) << backend.output();
+  EXPECT_EQ(logger.stop(), 0);
+  const auto original = slotStatesOf(out + "/run/run.lcmlog"), replayed = slotStatesOf(out + "/replay.lcmlog");
+  ASSERT_EQ(replayed.size(), original.size());
+  for (size_t i = 0; i < original.size(); ++i) EXPECT_EQ(encoded(replayed[i]), encoded(original[i])) << "frame " << i;
+}
+
+TEST(PipelineProcess, KilledTrackerIsReportedAndTheLogKept) {
+  const std::string out = scratchDir();
+  ChildProcess run(runArgs(out, {"--no-render", "--no-eval"}), out + "/../killed-run.log");
+  // Wait until the pipeline is running, then kill the tracker.
+  const std::string pidof = "pgrep -n -f dlslot-tracker > " + out + "/tracker.pid";
+  for (int i = 0; i < 200 && !fs::exists(out + "/run.lcmlog"); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  ASSERT_EQ(std::system(pidof.c_str()), 0);
+  int pid = 0;
+  std::ifstream(out + "/tracker.pid") >> pid;
+  ASSERT_GT(pid, 0);
+  kill(pid, SIGKILL);
+  const int code = run.wait(120);
+  EXPECT_NE(code, 0);
+  EXPECT_NE(code, -1);
+  const std::string text = run.output();
+  EXPECT_NE(text.find("tracker killed by signal 9"), std::string::npos) << text;
+  EXPECT_TRUE(fs::exists(out + "/run.lcmlog"));
+  EXPECT_FALSE(readLog(out + "/run.lcmlog")["LIDAR_SCAN"].empty());
+}
+
+TEST(PipelineProcess, BadConfigIsRefusedBeforeAnyProcessStarts) {
+  const std::string out = scratchDir();
+  const std::string shipped = config();
+  std::ifstream in(shipped);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  struct Case {
+    std::string name, yaml, expect;
+  };
+  std::string unknown = text, wrong = text;
+  unknown.replace(unknown.find("tracker:\n"), 9, "tracker:\n  no_such_key: 1\n");
+  wrong.replace(wrong.find("lockstep_timeout_s:"), 19, "lockstep_timeout_s: soon #");
+  for (const Case& c : {Case{"unknown", unknown, "tracker.no_such_key"}, Case{"wrong", wrong, "player.lockstep_timeout_s"},
+                        Case{"missing", "", "cannot open config file"}}) {
+    const std::string file = out + "/" + c.name + ".yaml";
+    if (!c.yaml.empty()) std::ofstream(file) << c.yaml;
+    std::vector<std::string> args = runArgs(out + "/" + c.name);
+    args[2] = file;
+    ChildProcess run(args, out + "/" + c.name + ".log");
+    EXPECT_EQ(run.wait(60), 2) << c.name << ": " << run.output();
+    EXPECT_NE(run.output().find(c.expect), std::string::npos) << c.name << ": " << run.output();
+    EXPECT_FALSE(fs::exists(out + "/" + c.name + "/run.lcmlog")) << c.name;
+  }
+}

@@ -30,6 +30,7 @@ struct TrackerConfig {
     s.get("gate_sq_m2", associator.gate_sq_m2);
     s.get("max_missed_frames", associator.max_missed_frames);
     s.get("max_polynomial_degree", associator.max_polynomial_degree);
+    s.get("max_noise_gain", associator.max_noise_gain);
     s.get("dynamic_displacement_m", associator.dynamic_displacement_m);
     s.get("join_timeout_s", join_timeout_s);
     const std::string predictor = s.get<std::string>("predictor");

@@ -25,6 +25,7 @@ void AssociatorConfig::validate() const {
     fail("max_missed_frames: expected 0..window_frames-1, got " + std::to_string(max_missed_frames));
   if (max_polynomial_degree < 1 || max_polynomial_degree > 3)
     fail("max_polynomial_degree: expected 1..3, got " + std::to_string(max_polynomial_degree));
+  if (!(max_noise_gain >= 1)) fail("max_noise_gain: expected >= 1, got " + std::to_string(max_noise_gain));
   if (!(dynamic_displacement_m >= 0))
     fail("dynamic_displacement_m: expected >= 0, got " + std::to_string(dynamic_displacement_m));
 }
@@ -61,7 +62,7 @@ Eigen::Vector3d TrajectoryAssociator::predict(const Trajectory& tr, double time_
   // initialized; with fewer, its last position is used and the match is not initialized.
   *initialized = static_cast<int>(tr.window.size()) >= config_.init_observations;
   if (*initialized && config_.predictor == Predictor::Polynomial)
-    return predictPolynomial(tr.window, time_s, config_.max_polynomial_degree);
+    return predictPolynomial(tr.window, time_s, config_.max_polynomial_degree, config_.max_noise_gain).position;
   return tr.window.back().position;
 }
 
@@ -95,17 +96,19 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
 
   // Eq. 6-7: a pair is admissible when its squared bird's-eye distance is below theta and the
   // classes are compatible. The binary score alone leaves ties (several admissible pairs per
-  // row); the cost breaks them towards nearer pairs while never trading an admissible pair for
-  // a nearer one: an admissible pair costs d^2/theta < 1, an inadmissible one more than any
-  // full set of admissible pairs could, so the assignment first maximises the number of
-  // admissible matches (the paper's score) and then minimises their distances.
+  // row); the cost breaks them without ever trading an admissible pair away: an admissible pair
+  // costs less than 1, an inadmissible one more than any full set of admissible pairs could, so
+  // the assignment first maximises the number of admissible matches (the paper's score). Among
+  // those it prefers initialized trajectories, whose prediction is a fit, over young ones
+  // predicting with a last position that may be a false positive (a matching cascade in one
+  // solve), and then nearer pairs.
   const double forbidden = std::min(U, V) + 1.0;
   Eigen::MatrixXd cost = Eigen::MatrixXd::Constant(U, V, forbidden);
   for (int u = 0; u < U; ++u) {
     for (int v = 0; v < V; ++v) {
       const double d2 = (predicted[u].head<2>() - out.associations[v].box_world.center.head<2>()).squaredNorm();
       if (d2 < config_.gate_sq_m2 && kitti::classesCompatible(trajectories_[u].last_box.type, detections[v].type))
-        cost(u, v) = d2 / config_.gate_sq_m2;
+        cost(u, v) = 0.5 * (d2 / config_.gate_sq_m2 + (initialized[u] ? 0.0 : 1.0));
     }
   }
   const std::vector<int> assignment = solveAssignment(cost);
@@ -132,6 +135,8 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
     }
     Trajectory& tr = trajectories_[u];
     tr.window.push_back(point);
+    // The window of k frames now ends at t: o_{t-k+1} .. o_t.
+    if (tr.window.front().frame <= frame - config_.window_frames) tr.window.erase(tr.window.begin());
     tr.last_box = a.box_world;
     tr.last_frame = frame;
     // Preliminary static/dynamic guess from the motion over the window (III-D).

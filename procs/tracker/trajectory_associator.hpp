@@ -20,10 +20,13 @@ Predictor predictorFromName(const std::string& name);  // "polynomial" | "last_p
 struct AssociatorConfig {
   int window_frames = 10;             // k: observations of the last k frames are kept
   int init_observations = 3;          // g: observations needed to fit and be "initialized"
-  double gate_sq_m2 = 9.0;            // theta of eq. 6, on the squared bird's-eye distance (eq. 7)
-  int max_missed_frames = 3;          // a trajectory unseen for more frames than this ends
+  // theta of eq. 6, on the squared bird's-eye distance (eq. 7). A young trajectory predicts with
+  // its last position, so theta must exceed what a car moves in a frame (3 m at 30 m/s and 10 Hz).
+  double gate_sq_m2 = 16.0;
+  int max_missed_frames = 5;          // a trajectory unseen for more frames than this ends
   Predictor predictor = Predictor::Polynomial;
   int max_polynomial_degree = 3;      // eq. 3 is a cubic
+  double max_noise_gain = 3.0;        // lower the degree while the fit extrapolates noise more (predictPolynomial)
   double dynamic_displacement_m = 1.0;  // window displacement above which a trajectory is dynamic
 
   void validate() const;  // std::invalid_argument naming the bad field

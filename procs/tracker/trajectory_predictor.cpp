@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace dlslot::tracker {
@@ -20,51 +21,70 @@ Coeffs powers(double s, int degree) {
   return p;
 }
 
-// Least-squares polynomial of `degree` through the xy of `points`, evaluated at time_s (eq. 5).
-Eigen::Vector2d fitAndEvaluate(const std::vector<TrajectoryPoint>& points, double time_s, int degree) {
-  const double t0 = points.front().time_s, t1 = points.back().time_s;
-  const double mid = 0.5 * (t0 + t1), half = 0.5 * (t1 - t0);
-  Normal AtA = Normal::Zero(degree + 1, degree + 1);
-  Rhs Atb = Rhs::Zero(degree + 1, 2);
-  for (const TrajectoryPoint& p : points) {
-    const Coeffs a = powers((p.time_s - mid) / half, degree);
-    AtA.noalias() += a * a.transpose();
-    Atb.noalias() += a * p.position.head<2>().transpose();
+// The normal equations A^T A theta = A^T b of eq. 5 for x and y at once, in normalised time.
+// Monomials nest, so the system of a lower degree is the top-left block of this one.
+struct NormalEquations {
+  double mid = 0, half = 1;
+  Normal AtA;
+  Rhs Atb;
+  NormalEquations(const std::vector<TrajectoryPoint>& points, int degree) {
+    const double t0 = points.front().time_s, t1 = points.back().time_s;
+    mid = 0.5 * (t0 + t1);
+    half = 0.5 * (t1 - t0);
+    AtA = Normal::Zero(degree + 1, degree + 1);
+    Atb = Rhs::Zero(degree + 1, 2);
+    for (const TrajectoryPoint& p : points) {
+      const Coeffs a = powers(normalised(p.time_s), degree);
+      AtA.noalias() += a * a.transpose();
+      Atb.noalias() += a * p.position.head<2>().transpose();
+    }
   }
-  const Rhs theta = AtA.ldlt().solve(Atb);
-  return (powers((time_s - mid) / half, degree).transpose() * theta).transpose();
-}
+  double normalised(double t) const { return (t - mid) / half; }
+};
 
 }  // namespace
 
-int polynomialDegree(int num_points, int max_degree) {
-  if (num_points < 2) return 0;
-  return std::clamp((num_points - 1) / 2, 1, std::clamp(max_degree, 1, kMaxCoeffs - 1));
-}
-
-Eigen::Vector3d predictPolynomial(const std::vector<TrajectoryPoint>& points, double time_s, int max_degree) {
+Prediction predictPolynomial(const std::vector<TrajectoryPoint>& points, double time_s, int max_degree,
+                             double max_noise_gain) {
   if (points.empty()) throw std::invalid_argument("predictPolynomial: no points");
+  Prediction out;
   double z = 0.0;
-  for (const TrajectoryPoint& p : points) z += p.position.z();
-  z /= static_cast<double>(points.size());
-
-  // Observations at one instant carry no velocity: the best guess is where they are.
-  const int degree = polynomialDegree(static_cast<int>(points.size()), max_degree);
-  if (degree == 0 || points.back().time_s <= points.front().time_s) {
-    Eigen::Vector2d xy = Eigen::Vector2d::Zero();
-    for (const TrajectoryPoint& p : points) xy += p.position.head<2>();
-    xy /= static_cast<double>(points.size());
-    return {xy.x(), xy.y(), z};
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const TrajectoryPoint& p : points) {
+    z += p.position.z();
+    mean += p.position.head<2>();
   }
-  const Eigen::Vector2d xy = fitAndEvaluate(points, time_s, degree);
-  return {xy.x(), xy.y(), z};
+  const double n = static_cast<double>(points.size());
+  out.position << mean / n, z / n;
+  out.noise_gain = 1.0 / std::sqrt(n);
+  // Observations at one instant carry no velocity: the best guess is where they are.
+  if (points.size() < 2 || points.back().time_s <= points.front().time_s) return out;
+
+  const int top = std::clamp(std::min(max_degree, static_cast<int>(points.size()) - 1), 1, kMaxCoeffs - 1);
+  const NormalEquations eq(points, top);
+  const Coeffs a_top = powers(eq.normalised(time_s), top);
+  for (int degree = top; degree >= 1; --degree) {
+    const int m = degree + 1;
+    const Eigen::LDLT<Normal> ldlt(Normal(eq.AtA.topLeftCorner(m, m)));
+    const Coeffs a = a_top.head(m);
+    // Var(a^T theta) = sigma^2 a^T (A^T A)^-1 a for white observation noise.
+    const double gain = std::sqrt(std::max(0.0, a.dot(ldlt.solve(a))));
+    if (gain > max_noise_gain && degree > 1) continue;
+    const Rhs theta = ldlt.solve(Rhs(eq.Atb.topRows(m)));
+    out.position.head<2>() = (a.transpose() * theta).transpose();
+    out.degree = degree;
+    out.noise_gain = gain;
+    return out;
+  }
+  return out;  // not reached: degree 1 always returns
 }
 
 double windowDisplacement(const std::vector<TrajectoryPoint>& points) {
   if (points.size() < 2 || points.back().time_s <= points.front().time_s) return 0.0;
-  const Eigen::Vector2d first = fitAndEvaluate(points, points.front().time_s, 1);
-  const Eigen::Vector2d last = fitAndEvaluate(points, points.back().time_s, 1);
-  return (last - first).norm();
+  const NormalEquations eq(points, 1);
+  const Eigen::Matrix<double, 2, 2> theta = eq.AtA.ldlt().solve(eq.Atb);
+  // Slope row times the span (-1 .. 1 in normalised time).
+  return 2.0 * theta.row(1).norm();
 }
 
 }  // namespace dlslot::tracker

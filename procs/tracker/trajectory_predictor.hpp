@@ -15,18 +15,24 @@ struct TrajectoryPoint {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
 };
 
-// The degree actually fitted to n observations: at most max_degree, and at least two
-// observations per non-constant coefficient ((n - 1) / 2), so no fit interpolates its points
-// exactly. An interpolating cubic through 4 noisy points extrapolates one step with 8.3x the
-// position noise; the least-squares cubic through 10 points with 1.9x, a line through 3 points
-// with 1.5x. Never below 1 for n >= 2 (a moving object needs at least a velocity).
-int polynomialDegree(int num_points, int max_degree);
+struct Prediction {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  int degree = 0;          // degree of the polynomial used
+  double noise_gain = 1.0; // predicted-position noise / observation noise (per axis, white noise)
+};
 
-// Predicted world position at `time_s` (eq. 3-5). Time is centred and scaled to [-1, 1] over the
-// window before fitting, so the normal equations stay well conditioned whatever the clock's
-// origin. x and y come from the polynomials; z (not modelled by the paper) is the mean height.
-// `points` must be non-empty and in time order.
-Eigen::Vector3d predictPolynomial(const std::vector<TrajectoryPoint>& points, double time_s, int max_degree = 3);
+// Predicted world position at `time_s` (eq. 3-5). `points` must be non-empty, in time order.
+//
+// Well conditioned in two senses. Numerically: time is centred and scaled to [-1, 1] over the
+// window before fitting, whatever the clock's origin. Statistically: a least-squares polynomial
+// extrapolates its observations' noise with a gain that grows with the degree and with the
+// horizon (a cubic through 4 points predicts one frame ahead with 8.3x the noise, three frames
+// ahead with 62x; through 10 points with 1.9x and 6x). So the degree is the highest one, up to
+// max_degree, whose gain stays within max_noise_gain; a short history or a prediction across
+// missed frames gets a lower degree, never below a line. z (not modelled by the paper) is the
+// mean height.
+Prediction predictPolynomial(const std::vector<TrajectoryPoint>& points, double time_s, int max_degree = 3,
+                             double max_noise_gain = 3.0);
 
 // Net displacement over the window in the xy plane, from a least-squares line (so observation
 // noise on a parked car does not read as motion): the basis of the static/dynamic guess (III-D).

@@ -1,0 +1,118 @@
+// The Hungarian solver against brute force on random matrices up to 8x8, square, rectangular
+// and empty.
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <limits>
+#include <random>
+
+#include "hungarian.hpp"
+
+using dlslot::tracker::solveAssignment;
+
+namespace {
+
+// Minimum total cost over every one-to-one assignment of min(rows, cols) pairs, by enumeration.
+double bruteForce(const Eigen::MatrixXd& c) {
+  const bool tall = c.rows() > c.cols();
+  const Eigen::MatrixXd a = tall ? Eigen::MatrixXd(c.transpose()) : c;  // rows <= cols
+  std::vector<char> used(a.cols(), 0);
+  double best = std::numeric_limits<double>::infinity();
+  std::function<void(int, double)> go = [&](int row, double sum) {
+    if (row == a.rows()) {
+      best = std::min(best, sum);
+      return;
+    }
+    for (int j = 0; j < a.cols(); ++j) {
+      if (used[j]) continue;
+      used[j] = 1;
+      go(row + 1, sum + a(row, j));
+      used[j] = 0;
+    }
+  };
+  go(0, 0.0);
+  return best;
+}
+
+// Checks the assignment is one to one, of the right size, and returns its cost.
+double checkedCost(const Eigen::MatrixXd& c, const std::vector<int>& assignment) {
+  EXPECT_EQ(assignment.size(), static_cast<size_t>(c.rows()));
+  std::vector<int> hits(c.cols(), 0);
+  double sum = 0;
+  int pairs = 0;
+  for (int i = 0; i < static_cast<int>(assignment.size()); ++i) {
+    if (assignment[i] < 0) continue;
+    EXPECT_LT(assignment[i], c.cols());
+    ++hits[assignment[i]];
+    sum += c(i, assignment[i]);
+    ++pairs;
+  }
+  for (int h : hits) EXPECT_LE(h, 1);
+  EXPECT_EQ(pairs, std::min(c.rows(), c.cols()));
+  return sum;
+}
+
+}  // namespace
+
+TEST(TrackerHungarian, EqualsBruteForceOnRandomMatricesUpTo8x8) {
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> real(0.0, 10.0);
+  std::uniform_int_distribution<int> small(0, 3);  // many ties
+  int checked = 0;
+  for (int rows = 1; rows <= 8; ++rows) {
+    for (int cols = 1; cols <= 8; ++cols) {
+      const int trials = rows * cols >= 49 ? 3 : 10;
+      for (int trial = 0; trial < trials; ++trial) {
+        Eigen::MatrixXd c(rows, cols);
+        for (int i = 0; i < rows; ++i)
+          for (int j = 0; j < cols; ++j) c(i, j) = trial % 2 ? real(rng) : small(rng);
+        const double got = checkedCost(c, solveAssignment(c));
+        EXPECT_NEAR(got, bruteForce(c), 1e-9) << rows << "x" << cols << " trial " << trial << "\n" << c;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 500);
+}
+
+TEST(TrackerHungarian, NegativeAndLargeCosts) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> real(-1e6, 1e6);
+  for (int trial = 0; trial < 20; ++trial) {
+    Eigen::MatrixXd c(6, 5);
+    for (int i = 0; i < c.size(); ++i) c(i) = real(rng);
+    EXPECT_NEAR(checkedCost(c, solveAssignment(c)), bruteForce(c), 1e-6);
+  }
+}
+
+TEST(TrackerHungarian, KnownAnswer) {
+  Eigen::MatrixXd c(3, 3);
+  c << 4, 1, 3,
+       2, 0, 5,
+       3, 2, 2;
+  // Greedy would take (1,1)=0 first and pay 4+0+2 or worse; the optimum is 1+2+2 = 5.
+  EXPECT_EQ(solveAssignment(c), (std::vector<int>{1, 0, 2}));
+}
+
+TEST(TrackerHungarian, RectangularLeavesExtraRowsUnassigned) {
+  Eigen::MatrixXd tall(3, 1);
+  tall << 5, 1, 3;
+  EXPECT_EQ(solveAssignment(tall), (std::vector<int>{-1, 0, -1}));
+  Eigen::MatrixXd wide(1, 3);
+  wide << 5, 1, 3;
+  EXPECT_EQ(solveAssignment(wide), (std::vector<int>{1}));
+}
+
+TEST(TrackerHungarian, EmptyMatrices) {
+  EXPECT_TRUE(solveAssignment(Eigen::MatrixXd(0, 0)).empty());
+  EXPECT_TRUE(solveAssignment(Eigen::MatrixXd(0, 4)).empty());
+  EXPECT_EQ(solveAssignment(Eigen::MatrixXd(3, 0)), (std::vector<int>{-1, -1, -1}));
+}
+
+TEST(TrackerHungarian, RejectsNonFiniteCosts) {
+  Eigen::MatrixXd c = Eigen::MatrixXd::Zero(2, 2);
+  c(0, 1) = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(solveAssignment(c), std::invalid_argument);
+  c(0, 1) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(solveAssignment(c), std::invalid_argument);
+}

@@ -40,12 +40,15 @@ std::string MatchCriterion::describe() const {
 void restrictClasses(std::vector<TrackingFrame>& frames, const std::vector<std::string>& classes) {
   if (classes.empty()) return;
   const auto evaluated = [&](const Box& b) { return std::find(classes.begin(), classes.end(), b.type) != classes.end(); };
+  const auto neighbouring = [&](const Box& b) {
+    return std::any_of(classes.begin(), classes.end(), [&](const std::string& c) { return kitti::classesCompatible(c, b.type); });
+  };
   for (TrackingFrame& f : frames) {
     std::vector<Object> kept;
     for (Object& o : f.truth) {
       if (evaluated(o.box))
         kept.push_back(std::move(o));
-      else
+      else if (neighbouring(o.box))
         f.ignore.push_back(o.box);
     }
     f.truth = std::move(kept);

@@ -45,8 +45,9 @@ struct MatchCriterion {
   std::string describe() const;  // e.g. "centre distance <= 2 m"
 };
 
-// Labels whose class is not in `classes` become ignore regions, tracks of other classes are
-// dropped (as the devkit does for the neighbouring classes). Empty `classes`: all are evaluated.
+// Evaluates only `classes` (empty: all), as the devkit does: labels of a neighbouring class
+// (compatible with an evaluated one, e.g. Van for Car) become ignore regions, labels of other
+// classes and tracks of classes not evaluated are dropped.
 void restrictClasses(std::vector<TrackingFrame>& frames, const std::vector<std::string>& classes);
 
 // Removes, frame by frame, the tracks that match no label (optimal assignment under `criterion`)

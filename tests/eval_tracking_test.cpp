@@ -1,0 +1,339 @@
+// Tracking metrics of the evaluator (box overlap, CLEAR MOT, HOTA, velocities) against
+// hand-computed answers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "assignment.hpp"
+#include "box_overlap.hpp"
+#include "clear_mot.hpp"
+#include "evaluation.hpp"
+#include "hota.hpp"
+#include "tracking_frames.hpp"
+#include "velocity.hpp"
+
+using namespace dlslot;
+using namespace dlslot::eval;
+
+namespace {
+
+Box box(double x, double y, int id, const std::string& type = "Car", double yaw = 0.0,
+        Eigen::Vector3d size = Eigen::Vector3d(4, 2, 1.5)) {
+  Box b;
+  b.center = Eigen::Vector3d(x, y, 0.75);
+  b.size = size;
+  b.yaw = yaw;
+  b.type = type;
+  b.id = id;
+  return b;
+}
+
+Object obj(double x, double y, int id, const std::string& type = "Car") { return {box(x, y, id, type), std::nullopt, false}; }
+
+const MatchCriterion kDistance;                                   // centre distance <= 2 m
+const MatchCriterion kIou{MatchCriterion::Kind::Iou3d};          // 3D IoU >= 0.25
+
+}  // namespace
+
+// ---------------- box overlap ----------------
+
+TEST(EvalBoxOverlap, IouOfKnownBoxes) {
+  const Eigen::Vector3d cube(2, 2, 2);
+  EXPECT_NEAR(iou3d(box(0, 0, 1, "Car", 0, cube), box(0, 0, 2, "Car", 0, cube)), 1.0, 1e-12);
+  // Shifted by half a side: intersection 1 x 2 x 2 = 4, union 8 + 8 - 4 = 12.
+  EXPECT_NEAR(iou3d(box(0, 0, 1, "Car", 0, cube), box(1, 0, 2, "Car", 0, cube)), 1.0 / 3.0, 1e-12);
+  // Shifted diagonally by (1, 1): 1 x 1 x 2 = 2 over 14.
+  EXPECT_NEAR(iou3d(box(0, 0, 1, "Car", 0, cube), box(1, 1, 2, "Car", 0, cube)), 2.0 / 14.0, 1e-12);
+  // A unit square and the same square turned 45 degrees: a regular octagon of area 2 (sqrt 2 - 1);
+  // with equal heights the IoU is 1 / sqrt 2.
+  const Eigen::Vector3d unit(1, 1, 1);
+  EXPECT_NEAR(bevIntersectionArea(box(0, 0, 1, "Car", 0, unit), box(0, 0, 2, "Car", M_PI / 4, unit)),
+              2.0 * (std::sqrt(2.0) - 1.0), 1e-12);
+  EXPECT_NEAR(iou3d(box(0, 0, 1, "Car", 0, unit), box(0, 0, 2, "Car", M_PI / 4, unit)), 1.0 / std::sqrt(2.0), 1e-12);
+  // Heights overlapping by half: intersection 4 x 2 x 0.75 = 6, union 12 + 12 - 6 = 18.
+  Box high = box(0, 0, 2);
+  high.center.z() += 0.75;
+  EXPECT_NEAR(iou3d(box(0, 0, 1), high), 6.0 / 18.0, 1e-12);
+  // A car turned by 90 degrees over another: the 2 x 2 middle square, 4 x 1.5 = 6 over 18.
+  EXPECT_NEAR(iou3d(box(0, 0, 1), box(0, 0, 2, "Car", M_PI / 2)), 6.0 / 18.0, 1e-12);
+  EXPECT_EQ(iou3d(box(0, 0, 1), box(10, 0, 2)), 0.0);
+  EXPECT_EQ(iou3d(box(0, 0, 1), box(0, 0, 2, "Car", 0, Eigen::Vector3d::Zero())), 0.0);
+}
+
+TEST(EvalBoxOverlap, FootprintAndDistance) {
+  EXPECT_NEAR(bevDistance(box(0, 0, 1), box(3, 4, 2)), 5.0, 1e-12);
+  EXPECT_TRUE(footprintContains(box(0, 0, 1, "Car", M_PI / 2), Eigen::Vector3d(0, 1.9, 50)));
+  EXPECT_FALSE(footprintContains(box(0, 0, 1, "Car", M_PI / 2), Eigen::Vector3d(1.9, 0, 0)));
+}
+
+// ---------------- assignment ----------------
+
+TEST(EvalAssignment, FindsTheMinimumCostAssignment) {
+  Eigen::MatrixXd c(3, 3);
+  c << 4, 1, 3,  //
+      2, 0, 5,   //
+      3, 2, 2;
+  EXPECT_EQ(minCostAssignment(c), (std::vector<int>{1, 0, 2}));  // 1 + 2 + 2 = 5
+  Eigen::MatrixXd wide(2, 3);
+  wide << 5, 1, 9,  //
+      1, 2, 9;
+  EXPECT_EQ(minCostAssignment(wide), (std::vector<int>{1, 0}));
+  EXPECT_EQ(minCostAssignment(Eigen::MatrixXd(wide.transpose())), (std::vector<int>{1, 0, -1}));
+  // Forbidden pairs are never returned, even when a row has nothing else.
+  const auto col = assignAllowedPairs(2, 2, [](int i, int j) -> std::optional<double> {
+    if (i == 1) return std::nullopt;
+    return j == 0 ? 1.0 : 2.0;
+  });
+  EXPECT_EQ(col, (std::vector<int>{0, -1}));
+  // Most pairs first: matching (0,1) and (1,0) beats the single cheapest pair (0,0).
+  const auto most = assignAllowedPairs(2, 2, [](int i, int j) -> std::optional<double> {
+    if (i == 1 && j == 1) return std::nullopt;
+    return i == 0 && j == 0 ? 0.0 : 1.0;
+  });
+  EXPECT_EQ(most, (std::vector<int>{1, 0}));
+}
+
+// ---------------- CLEAR MOT and HOTA ----------------
+
+TEST(EvalTracking, PerfectTrackerScoresPerfectly) {
+  std::vector<TrackingFrame> frames;
+  for (int t = 0; t < 10; ++t) {
+    TrackingFrame f;
+    f.frame = t;
+    for (int k = 0; k < 3; ++k) {
+      f.truth.push_back(obj(10.0 * k + t, 5.0 * k, k));
+      f.tracks.push_back(obj(10.0 * k + t, 5.0 * k, 100 + k));
+    }
+    frames.push_back(f);
+  }
+  for (const MatchCriterion& c : {kDistance, kIou}) {
+    const ClearMot m = evaluateClearMot(frames, c);
+    EXPECT_EQ(m.num_truth, 30);
+    EXPECT_EQ(m.tp, 30);
+    EXPECT_EQ(m.fp, 0);
+    EXPECT_EQ(m.fn, 0);
+    EXPECT_EQ(m.idsw, 0);
+    EXPECT_DOUBLE_EQ(*m.mota, 1.0);
+    EXPECT_NEAR(*m.motp_m, 0.0, 1e-12);
+    const auto h = evaluateHota(frames, c);
+    ASSERT_TRUE(h);
+    EXPECT_NEAR(h->hota, 1.0, 1e-12) << c.describe();
+    EXPECT_NEAR(h->deta, 1.0, 1e-12);
+    EXPECT_NEAR(h->assa, 1.0, 1e-12);
+  }
+}
+
+TEST(EvalTracking, IdSwapCountsTwoSwitchesAndThirdsTheAssociation) {
+  // Labels A (id 1) at x = 0 and B (id 2) at x = 50 for 4 frames; tracks 10 and 20 follow A and B
+  // for two frames, then swap. CLEAR: 2 switches (frame 2, one per label), MOTA = 1 - 2/8.
+  // HOTA: every detection is exact (DetA = 1); each (label, track) pair is matched in 2 frames
+  // while each id lives 4 frames, so every TP has association IoU 2 / (4 + 4 - 2) = 1/3:
+  // AssA = 1/3 and HOTA = sqrt(1/3) at every alpha.
+  std::vector<TrackingFrame> frames;
+  for (int t = 0; t < 4; ++t) {
+    TrackingFrame f;
+    f.frame = t;
+    f.truth = {obj(0, t, 1), obj(50, t, 2)};
+    const bool swapped = t >= 2;
+    f.tracks = {obj(0, t, swapped ? 20 : 10), obj(50, t, swapped ? 10 : 20)};
+    frames.push_back(f);
+  }
+  const ClearMot m = evaluateClearMot(frames, kDistance);
+  EXPECT_EQ(m.idsw, 2);
+  EXPECT_EQ(m.fp, 0);
+  EXPECT_EQ(m.fn, 0);
+  EXPECT_DOUBLE_EQ(*m.mota, 0.75);
+  const auto h = evaluateHota(frames, kDistance);
+  EXPECT_NEAR(h->deta, 1.0, 1e-12);
+  EXPECT_NEAR(h->assa, 1.0 / 3.0, 1e-12);
+  EXPECT_NEAR(h->hota, std::sqrt(1.0 / 3.0), 1e-12);
+}
+
+TEST(EvalTracking, MissesAndFalsePositives) {
+  // One label over 5 frames, tracked (id 10) in frames 0, 1, 4 only: FN = 2; a spurious track
+  // (id 99) far away in frame 3: FP = 1. MOTA = 1 - 3/5 = 0.4.
+  // HOTA: TP 3, FN 2, FP 1 -> DetA = 3/6; the pair (1, 10) is matched 3 times, label 1 lives 5
+  // frames and track 10 three: association IoU 3 / (5 + 3 - 3) = 0.6 = AssA; HOTA = sqrt(0.3).
+  std::vector<TrackingFrame> frames;
+  for (int t = 0; t < 5; ++t) {
+    TrackingFrame f;
+    f.frame = t;
+    f.truth = {obj(t, 0, 1)};
+    if (t == 0 || t == 1 || t == 4) f.tracks.push_back(obj(t, 0, 10));
+    if (t == 3) f.tracks.push_back(obj(30, 30, 99));
+    frames.push_back(f);
+  }
+  const ClearMot m = evaluateClearMot(frames, kDistance);
+  EXPECT_EQ(m.fn, 2);
+  EXPECT_EQ(m.fp, 1);
+  EXPECT_EQ(m.idsw, 0);  // the same track resumes: a fragmentation, not a switch
+  EXPECT_NEAR(*m.mota, 0.4, 1e-12);
+  const auto h = evaluateHota(frames, kDistance);
+  EXPECT_NEAR(h->deta, 0.5, 1e-12);
+  EXPECT_NEAR(h->assa, 0.6, 1e-12);
+  EXPECT_NEAR(h->hota, std::sqrt(0.3), 1e-12);
+}
+
+TEST(EvalTracking, LocalisationErrorLowersHotaAndSetsMotp) {
+  // Every track 0.5 m beside its label: distance similarity 1 - 0.5/2 = 0.75, a true positive
+  // for alpha = 0.05 .. 0.75 (15 of 19 thresholds), with DetA = AssA = 1 there.
+  std::vector<TrackingFrame> frames;
+  for (int t = 0; t < 6; ++t) {
+    TrackingFrame f;
+    f.frame = t;
+    f.truth = {obj(t, 0, 1)};
+    f.tracks = {obj(t, 0.5, 7)};
+    frames.push_back(f);
+  }
+  const ClearMot m = evaluateClearMot(frames, kDistance);
+  EXPECT_NEAR(*m.motp_m, 0.5, 1e-12);
+  EXPECT_DOUBLE_EQ(*m.mota, 1.0);
+  const auto h = evaluateHota(frames, kDistance);
+  EXPECT_NEAR(h->hota, 15.0 / 19.0, 1e-12);
+  EXPECT_NEAR(h->loca, 0.75 * 15.0 / 19.0, 1e-12);
+  // 2.5 m away is outside the 2 m gate: a miss and a false positive per frame.
+  for (auto& f : frames) f.tracks[0].box.center.y() = 2.5;
+  const ClearMot far = evaluateClearMot(frames, kDistance);
+  EXPECT_EQ(far.tp, 0);
+  EXPECT_EQ(far.fn, 6);
+  EXPECT_EQ(far.fp, 6);
+  EXPECT_NEAR(*far.mota, -1.0, 1e-12);
+  EXPECT_NEAR(evaluateHota(frames, kDistance)->hota, 0.0, 1e-12);
+}
+
+TEST(EvalTracking, KeepsTheLastCorrespondenceWhileItIsValid) {
+  // Track 10 follows the label 1 m off; from frame 1 track 20 sits exactly on it. CLEAR MOT keeps
+  // the existing correspondence (no switch); track 20 is a false positive.
+  std::vector<TrackingFrame> frames(3);
+  for (int t = 0; t < 3; ++t) {
+    frames[t].frame = t;
+    frames[t].truth = {obj(0, 0, 1)};
+    frames[t].tracks = {obj(1, 0, 10)};
+    if (t > 0) frames[t].tracks.push_back(obj(0, 0, 20));
+  }
+  const ClearMot m = evaluateClearMot(frames, kDistance);
+  EXPECT_EQ(m.idsw, 0);
+  EXPECT_EQ(m.fp, 2);
+  EXPECT_NEAR(*m.motp_m, 1.0, 1e-12);
+}
+
+TEST(EvalTracking, ClassesMatchAsInTheKittiDevkit) {
+  TrackingFrame f;
+  f.truth = {obj(0, 0, 1, "Van"), obj(20, 0, 2, "Pedestrian")};
+  f.tracks = {obj(0, 0, 10, "Car"), obj(20, 0, 11, "Car")};
+  const ClearMot m = evaluateClearMot({f}, kDistance);
+  EXPECT_EQ(m.tp, 1);  // Car ~ Van
+  EXPECT_EQ(m.fp, 1);  // a Car is no Pedestrian
+  EXPECT_EQ(m.fn, 1);
+  // Evaluating only cars: the Van (a neighbouring class) becomes an ignore region, so the Car
+  // track on it is neither FP nor TP; the pedestrian label is not evaluated at all.
+  std::vector<TrackingFrame> only_cars = {f};
+  restrictClasses(only_cars, {"Car"});
+  dropIgnoredTracks(only_cars, kDistance);
+  const ClearMot c = evaluateClearMot(only_cars, kDistance);
+  EXPECT_EQ(c.num_truth, 0);
+  EXPECT_EQ(c.fp, 1);  // the Car track on the pedestrian
+  EXPECT_FALSE(c.mota);
+}
+
+TEST(EvalTracking, TracksInDontCareRegionsAreNeitherFalseNorTruePositives) {
+  TrackingFrame f;
+  f.truth = {obj(0, 0, 1)};
+  f.ignore = {box(30, 0, -1, "DontCare", 0, Eigen::Vector3d(10, 10, 3))};
+  f.tracks = {obj(0, 0, 10), obj(33, 2, 11), obj(60, 0, 12)};
+  std::vector<TrackingFrame> frames = {f};
+  dropIgnoredTracks(frames, kDistance);
+  ASSERT_EQ(frames[0].tracks.size(), 2u);
+  const ClearMot m = evaluateClearMot(frames, kDistance);
+  EXPECT_EQ(m.tp, 1);
+  EXPECT_EQ(m.fp, 1);  // only the track at x = 60
+  // A track matched to a label stays even inside a DontCare region.
+  TrackingFrame g;
+  g.truth = {obj(30, 0, 1)};
+  g.ignore = f.ignore;
+  g.tracks = {obj(30, 0.5, 10)};
+  std::vector<TrackingFrame> inside = {g};
+  dropIgnoredTracks(inside, kDistance);
+  EXPECT_EQ(evaluateClearMot(inside, kDistance).tp, 1);
+}
+
+TEST(EvalTracking, NoLabelsAndNoTracksAreNotMeasurable) {
+  std::vector<TrackingFrame> frames(3);
+  EXPECT_FALSE(evaluateClearMot(frames, kDistance).mota);
+  EXPECT_FALSE(evaluateHota(frames, kDistance));
+}
+
+// ---------------- velocities ----------------
+
+TEST(EvalVelocity, WorldVelocitiesAreExpressedInEachScansLidarAxes) {
+  // An object drives along world +x at 10 m/s; the ego moves along world +y at 5 m/s, heading
+  // +y (yaw 90 deg). In the lidar axes the object's velocity over ground is (0, -10).
+  std::vector<TrackingFrame> frames;
+  for (int t = 0; t < 5; ++t) {
+    TrackingFrame f;
+    f.frame = t;
+    f.stamp = 0.1 * t;
+    Pose ego = Pose::Identity();
+    ego.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    ego.translation() << 0, 0.5 * t, 0;
+    f.truth_pose = ego;
+    Box world = box(1.0 * t, 20, 1);
+    f.truth = {{world.transformed(ego.inverse()), std::nullopt, false}};
+    frames.push_back(f);
+  }
+  finiteDifferenceVelocities(frames, Side::Truth, VelocityFrame::World, true);
+  markDynamicLabels(frames, VelocityFrame::World, 0.5);
+  for (const auto& f : frames) {
+    ASSERT_TRUE(f.truth[0].velocity);
+    EXPECT_NEAR(f.truth[0].velocity->x(), 0.0, 1e-9);
+    EXPECT_NEAR(f.truth[0].velocity->y(), -10.0, 1e-9);
+    EXPECT_TRUE(f.truth[0].dynamic);
+  }
+  // In the sensor frame a parked object seen from an ego driving 10 m/s forward moves backwards.
+  std::vector<TrackingFrame> sensor(3);
+  for (int t = 0; t < 3; ++t) {
+    sensor[t].stamp = 0.1 * t;
+    sensor[t].truth = {obj(20.0 - 1.0 * t, 0, 1)};
+  }
+  finiteDifferenceVelocities(sensor, Side::Truth, VelocityFrame::Sensor, true);
+  EXPECT_NEAR(sensor[1].truth[0].velocity->x(), -10.0, 1e-9);
+  EXPECT_THROW(finiteDifferenceVelocities(sensor, Side::Truth, VelocityFrame::World, true), std::invalid_argument);
+}
+
+TEST(EvalVelocity, RmseOverMatchedDynamicLabels) {
+  std::vector<TrackingFrame> frames(2);
+  for (int t = 0; t < 2; ++t) {
+    frames[t].truth = {obj(0, 0, 1), obj(20, 0, 2)};
+    frames[t].truth[0].velocity = Eigen::Vector2d(10, 0);
+    frames[t].truth[0].dynamic = true;
+    frames[t].truth[1].velocity = Eigen::Vector2d(0, 0);  // parked: not counted
+    frames[t].tracks = {obj(0, 0, 5), obj(20, 0, 6)};
+    frames[t].tracks[0].velocity = Eigen::Vector2d(t == 0 ? 11 : 10, t == 0 ? 0 : 3);
+    frames[t].tracks[1].velocity = Eigen::Vector2d(5, 5);
+  }
+  const ClearMot m = evaluateClearMot(frames, kDistance);
+  EXPECT_EQ(m.velocity_pairs, 2);
+  EXPECT_NEAR(*m.velocity_rmse_mps, std::sqrt((1.0 + 9.0) / 2.0), 1e-12);
+}
+
+TEST(EvalVelocity, EvaluateComparesTheSystemsVelocityWithGroundTruthMotion) {
+  // Full evaluate(): labels move 10 m/s along x in a world the ego does not move in; the
+  // tracks carry the system's velocity estimate, 1 m/s too fast.
+  RunData run;
+  run.has_labels = run.has_tracks = run.track_velocities_given = true;
+  for (int t = 0; t < 5; ++t) {
+    TrackingFrame f;
+    f.frame = t;
+    f.stamp = 0.1 * t;
+    f.truth_pose = f.ego_pose = Pose::Identity();
+    f.truth = {obj(1.0 * t, 0, 1)};
+    f.tracks = {obj(1.0 * t, 0, 3)};
+    f.tracks[0].velocity = Eigen::Vector2d(11, 0);
+    run.tracking.push_back(f);
+  }
+  const Metrics m = evaluate(run, EvalOptions());
+  ASSERT_TRUE(m.tracking);
+  EXPECT_NEAR(*m.tracking->clear.velocity_rmse_mps, 1.0, 1e-9);
+  EXPECT_NEAR(m.tracking->hota->hota, 1.0, 1e-12);
+  EXPECT_NE(m.velocity_frame.find("world"), std::string::npos);
+}

@@ -1,0 +1,89 @@
+#include "backend/backend_config.hpp"
+
+#include <stdexcept>
+#include <vector>
+
+namespace dlslot::backend {
+
+Mode parseMode(const std::string& name) {
+  if (name == "slot") return Mode::kSlot;
+  if (name == "two-stage") return Mode::kTwoStage;
+  if (name == "odometry-only") return Mode::kOdometryOnly;
+  throw std::invalid_argument("backend mode: expected slot, two-stage or odometry-only, got '" + name + "'");
+}
+
+std::string toString(Mode mode) {
+  switch (mode) {
+    case Mode::kSlot: return "slot";
+    case Mode::kTwoStage: return "two-stage";
+    case Mode::kOdometryOnly: return "odometry-only";
+  }
+  return "?";
+}
+
+namespace {
+
+Vector6 readSigmas(ConfigSection& s, const std::string& key) {
+  std::vector<double> v;
+  s.get(key, v);
+  if (v.size() != 6) {
+    throw ConfigError(s.file() + ": " + s.path() + "." + key + ": expected 6 standard deviations [tx ty tz rx ry rz], got " +
+                      std::to_string(v.size()) + " values");
+  }
+  Vector6 out;
+  for (int i = 0; i < 6; ++i) {
+    if (!(v[i] > 0.0))
+      throw ConfigError(s.file() + ": " + s.path() + "." + key + ": standard deviations must be > 0");
+    out[i] = v[i];
+  }
+  return out;
+}
+
+void require(bool ok, const ConfigSection& s, const std::string& key, const std::string& expected) {
+  if (!ok) throw ConfigError(s.file() + ": " + s.path() + "." + key + ": expected " + expected);
+}
+
+}  // namespace
+
+BackendConfig BackendConfig::read(ConfigSection& s) {
+  BackendConfig c;
+  const std::string mode = s.get<std::string>("mode");
+  try {
+    c.mode = parseMode(mode);
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(s.file() + ": " + s.path() + ".mode: " + e.what());
+  }
+  s.get("window_size", c.window_size);
+  require(c.window_size >= 2, s, "window_size", "an integer >= 2");
+  c.odometry_sigma = readSigmas(s, "odometry_sigma");
+  c.observation_sigma = readSigmas(s, "observation_sigma");
+  c.landmark_sigma = readSigmas(s, "landmark_sigma");
+  c.pose_change_sigma = readSigmas(s, "pose_change_sigma");
+  c.constant_velocity_sigma = readSigmas(s, "constant_velocity_sigma");
+  c.first_pose_sigma = readSigmas(s, "first_pose_sigma");
+  s.get("degraded_odometry_scale", c.degraded_odometry_scale);
+  require(c.degraded_odometry_scale >= 1.0, s, "degraded_odometry_scale", "a number >= 1");
+  s.get("use_odometry_covariance", c.use_odometry_covariance);
+  s.get("observation_loss", c.observation_loss);
+  require(c.observation_loss == "none" || c.observation_loss == "huber" || c.observation_loss == "cauchy", s,
+          "observation_loss", "none, huber or cauchy");
+  s.get("observation_loss_scale", c.observation_loss_scale);
+  require(c.observation_loss_scale > 0.0, s, "observation_loss_scale", "a number > 0");
+  s.get("static_max_speed", c.static_max_speed);
+  require(c.static_max_speed >= 0.0, s, "static_max_speed", "a speed >= 0 (m/s)");
+  s.get("switch_distance", c.switch_distance);
+  require(c.switch_distance > 0.0, s, "switch_distance", "a distance > 0 (m)");
+  s.get("switch_frames", c.switch_frames);
+  require(c.switch_frames >= 1, s, "switch_frames", "an integer >= 1");
+  s.get("max_iterations", c.max_iterations);
+  require(c.max_iterations >= 1, s, "max_iterations", "an integer >= 1");
+  s.get("function_tolerance", c.function_tolerance);
+  s.get("gradient_tolerance", c.gradient_tolerance);
+  s.get("parameter_tolerance", c.parameter_tolerance);
+  s.get("compute_covariance", c.compute_covariance);
+  return c;
+}
+
+Matrix6 sqrtInformation(const Vector6& sigma) { return sigma.cwiseInverse().asDiagonal(); }
+
+}  // namespace dlslot::backend

@@ -1,0 +1,65 @@
+// The backend's settings (config/dlslot.yaml, section `backend`): window, modes, the
+// covariances of eq. 12 per factor type, robust loss, static/dynamic decision, solver.
+#pragma once
+
+#include <string>
+
+#include "backend/se3.hpp"
+#include "dlslot/config.hpp"
+
+namespace dlslot::backend {
+
+// slot: ego poses, landmarks and objects estimated jointly (DL-SLOT). two-stage: ego poses held
+// at the odometry's, objects estimated alone (the decoupled baseline). odometry-only: ego poses
+// from the odometry, no objects (A-LOAM*).
+enum class Mode { kSlot, kTwoStage, kOdometryOnly };
+Mode parseMode(const std::string& name);  // throws std::invalid_argument
+std::string toString(Mode mode);
+
+struct BackendConfig {
+  Mode mode = Mode::kSlot;
+  int window_size = 10;  // k frames
+
+  // Standard deviations [tx ty tz (m), rx ry rz (rad)] of each factor's residual; the
+  // information matrix is diag(sigma)^-2 (the Sigma of eq. 12).
+  Vector6 odometry_sigma = (Vector6() << 0.03, 0.03, 0.03, 0.003, 0.003, 0.003).finished();
+  Vector6 observation_sigma = (Vector6() << 0.25, 0.15, 0.15, 0.05, 0.05, 0.1).finished();
+  Vector6 landmark_sigma = (Vector6() << 0.15, 0.1, 0.1, 0.05, 0.05, 0.05).finished();
+  Vector6 pose_change_sigma = (Vector6() << 0.02, 0.02, 0.02, 0.005, 0.005, 0.005).finished();
+  Vector6 constant_velocity_sigma = (Vector6() << 0.05, 0.03, 0.02, 0.005, 0.005, 0.01).finished();
+  Vector6 first_pose_sigma = (Vector6() << 1e-3, 1e-3, 1e-3, 1e-4, 1e-4, 1e-4).finished();
+  // Odometry sigmas are multiplied by this when the odometry fell back to a prediction or
+  // did not arrive (then the pose is predicted with constant velocity).
+  double degraded_odometry_scale = 10.0;
+  // Use the odometry message's covariance instead of odometry_sigma when it is valid.
+  bool use_odometry_covariance = false;
+
+  // Robust loss on (landmark) observations, the factors that see outliers: none|huber|cauchy,
+  // scale in whitened units (1 = one sigma).
+  std::string observation_loss = "cauchy";
+  double observation_loss_scale = 1.0;
+
+  // A new object whose positions in the window move slower than this (m/s, least-squares
+  // slope) starts as a static landmark; faster ones are dynamic.
+  double static_max_speed = 1.0;
+  // A landmark turns dynamic when its last `switch_frames` observations each lie farther than
+  // `switch_distance` (m, bird's-eye) from it (a parked car pulls out).
+  double switch_distance = 0.6;
+  int switch_frames = 2;
+
+  // Ceres (Levenberg-Marquardt, sparse normal Cholesky).
+  int max_iterations = 10;
+  double function_tolerance = 1e-6;
+  double gradient_tolerance = 1e-10;
+  double parameter_tolerance = 1e-8;
+  // Marginal covariances of the newest ego pose and the tracks (ceres::Covariance).
+  bool compute_covariance = true;
+
+  // Reads every key above from `section` (not finish(): the node reads its own keys too).
+  static BackendConfig read(ConfigSection& section);
+};
+
+// diag(1 / sigma): the square-root information of independent residual components.
+Matrix6 sqrtInformation(const Vector6& sigma);
+
+}  // namespace dlslot::backend

@@ -1,0 +1,78 @@
+// What the backend takes and gives per frame, as plain types (the node converts messages).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "backend/se3.hpp"
+#include "dlslot/types.hpp"
+
+namespace dlslot::backend {
+
+struct OdometryInput {
+  Pose pose = Pose::Identity();   // T_world_lidar of the frame, as the odometry chains it
+  Pose delta = Pose::Identity();  // T_prev_cur: the motion since the previous frame (eq. 8's T)
+  Matrix6 covariance = Matrix6::Identity();  // of delta, (tx ty tz rx ry rz)
+  bool ok = true;                 // false: the odometry fell back to a prediction
+};
+
+// One associated detection (paper III-B): b_t and the tracker's view of its trajectory.
+struct ObservationInput {
+  int track_id = -1;
+  bool initialized = false;   // the trajectory is in O_init (>= g observations)
+  Box box;                    // b_t: lidar frame of this scan (centre, size l w h, yaw, type)
+  bool dynamic_guess = false; // the tracker's preliminary static/dynamic guess
+};
+
+struct BackendInput {
+  int frame = 0;
+  int64_t utime = 0;
+  std::optional<OdometryInput> odometry;  // none: no ODOMETRY arrived for this frame
+  bool associations_missing = false;      // no ASSOCIATIONS arrived: no objects this frame
+  std::vector<ObservationInput> observations;
+};
+
+struct TrackEstimate {
+  int id = -1;
+  std::string type;
+  Pose pose = Pose::Identity();  // T_world_object at the newest frame
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();          // world frame, m/s
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // world frame, rad/s
+  bool dynamic = false;
+  Matrix6 covariance = Matrix6::Zero();  // tangent of the PoseManifold (world-frame dt, dtheta)
+  int age = 0;               // frames since first seen
+  int num_observations = 0;  // observations in the window
+  int last_seen_frame = -1;
+};
+
+struct SolveStats {
+  double solve_ms = 0, marginalize_ms = 0, covariance_ms = 0, total_ms = 0;
+  int iterations = 0;
+  double initial_cost = 0, final_cost = 0;
+  int num_blocks = 0, num_factors = 0;
+  int prior_dim = 0;  // tangent dimension of the marginalization prior
+};
+
+struct SmoothedPose {
+  int frame = 0;
+  int64_t utime = 0;
+  Pose pose = Pose::Identity();
+};
+
+struct BackendOutput {
+  int frame = 0;
+  int64_t utime = 0;
+  Pose ego_pose = Pose::Identity();  // newest optimized T_world_lidar
+  Matrix6 ego_covariance = Matrix6::Zero();
+  std::optional<SmoothedPose> smoothed;  // the frame that left the window with this solve
+  bool odometry_missing = false;
+  bool associations_missing = false;
+  std::vector<TrackEstimate> tracks;
+  SolveStats stats;
+  int static_to_dynamic = 0;  // landmarks that turned dynamic this frame
+};
+
+}  // namespace dlslot::backend

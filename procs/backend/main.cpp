@@ -1,0 +1,187 @@
+// dlslot-backend: ODOMETRY + ASSOCIATIONS of a frame -> the sliding-window optimization ->
+// SLOT_STATE. Live over LCM, or offline from a recorded log (--offline IN --out OUT).
+#include <lcm/lcm-cpp.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <stdexcept>
+
+#include "backend/backend_messages.hpp"
+#include "backend/frame_joiner.hpp"
+#include "backend/sliding_window.hpp"
+#include "dlslot/node.hpp"
+#include "dlslot/timing_stats.hpp"
+
+using namespace dlslot;
+using namespace dlslot::backend;
+
+namespace {
+
+struct OdometryPart {
+  int64_t utime = 0;
+  OdometryInput odometry;
+};
+struct AssociationsPart {
+  int64_t utime = 0;
+  std::vector<ObservationInput> observations;
+};
+using Joiner = FrameJoiner<OdometryPart, AssociationsPart>;
+
+BackendInput toInput(const Joiner::Joined& j) {
+  BackendInput in;
+  in.frame = j.frame;
+  in.utime = j.a ? j.a->utime : j.b->utime;
+  if (j.a) in.odometry = j.a->odometry;
+  in.associations_missing = !j.b;
+  if (j.b) in.observations = j.b->observations;
+  return in;
+}
+
+double nowSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+void setCounter(ProcessStatus& status, const std::string& name, int64_t value) {
+  status.count(name, value - status.counter(name));
+}
+
+void report(ProcessStatus& status, const BackendOutput& out) {
+  status.frameDone(out.frame, out.stats.total_ms);
+  setCounter(status, "last_solve_us", static_cast<int64_t>(1000.0 * out.stats.solve_ms));
+  setCounter(status, "last_marginalize_us", static_cast<int64_t>(1000.0 * out.stats.marginalize_ms));
+  setCounter(status, "last_iterations", out.stats.iterations);
+  setCounter(status, "last_final_cost_milli", static_cast<int64_t>(1000.0 * out.stats.final_cost));
+  setCounter(status, "last_prior_dim", out.stats.prior_dim);
+  setCounter(status, "tracks", static_cast<int64_t>(out.tracks.size()));
+  if (out.odometry_missing) status.count("odometry_missing");
+  if (out.associations_missing) status.count("associations_missing");
+  if (out.static_to_dynamic) status.count("static_to_dynamic", out.static_to_dynamic);
+}
+
+// Offline: every ODOMETRY and ASSOCIATIONS event of a log, joined by frame, in frame order.
+int runOffline(const BackendConfig& config, const Channels& channels, const std::string& in_path,
+               const std::string& out_path) {
+  lcm::LogFile in(in_path, "r");
+  if (!in.good()) throw std::runtime_error(in_path + ": cannot open LCM log for reading");
+  Joiner joiner(std::numeric_limits<double>::infinity());
+  int decode_errors = 0, rejected = 0;
+  while (const lcm::LogEvent* ev = in.readNextEvent()) {
+    if (ev->channel == channels.odometry) {
+      odometry_t m;
+      if (m.decode(ev->data, 0, ev->datalen) < 0) {
+        ++decode_errors;
+        continue;
+      }
+      joiner.addA(m.frame, OdometryPart{m.utime, fromMsg(m)}, 0.0);
+    } else if (ev->channel == channels.associations) {
+      associations_t m;
+      if (m.decode(ev->data, 0, ev->datalen) < 0) {
+        ++decode_errors;
+        continue;
+      }
+      joiner.addB(m.frame, AssociationsPart{m.utime, observationsFromMsg(m, &rejected)}, 0.0);
+    }
+  }
+  std::unique_ptr<lcm::LogFile> out;
+  if (!out_path.empty()) {
+    out = std::make_unique<lcm::LogFile>(out_path, "w");
+    if (!out->good()) throw std::runtime_error(out_path + ": cannot open LCM log for writing");
+  }
+  SlidingWindow window(config);
+  TimingStats total, solve, marginalize;
+  int frames = 0, missing_odometry = 0, missing_associations = 0;
+  for (const Joiner::Joined& j : joiner.flush()) {
+    const BackendOutput result = window.process(toInput(j));
+    ++frames;
+    missing_odometry += result.odometry_missing;
+    missing_associations += result.associations_missing;
+    total.add(result.stats.total_ms);
+    solve.add(result.stats.solve_ms);
+    marginalize.add(result.stats.marginalize_ms);
+    if (!out) continue;
+    const slot_state_t msg = toMsg(result, toString(config.mode));
+    std::vector<uint8_t> buf(msg.getEncodedSize());
+    msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
+    lcm::LogEvent ev;
+    ev.eventnum = frames - 1;
+    ev.timestamp = result.utime;
+    ev.channel = channels.slot_state;
+    ev.datalen = static_cast<int32_t>(buf.size());
+    ev.data = buf.data();
+    if (out->writeEvent(&ev) != 0) throw std::runtime_error(out_path + ": write failed");
+  }
+  std::printf("backend (%s): %d frames, %d without odometry, %d without associations, %d undecodable, %d bad boxes\n",
+              toString(config.mode).c_str(), frames, missing_odometry, missing_associations, decode_errors, rejected);
+  std::printf("  total %.2f ms mean, %.2f p95; solve %.2f mean; marginalize %.2f mean\n", total.mean(),
+              total.percentile(95), solve.mean(), marginalize.mean());
+  return 0;
+}
+
+int runLive(const BackendConfig& config, const Channels& channels, const NodeOptions& opts, double join_timeout_s) {
+  Node node("backend", opts.lcm_url, channels);
+  SlidingWindow window(config);
+  Joiner joiner(join_timeout_s);
+  const std::string mode = toString(config.mode);
+
+  auto handleReady = [&] {
+    for (const Joiner::Joined& j : joiner.release(nowSeconds())) {
+      if (!j.a) node.status().timeout("ODOMETRY of frame " + std::to_string(j.frame));
+      if (!j.b) node.status().timeout("ASSOCIATIONS of frame " + std::to_string(j.frame));
+      try {
+        const BackendOutput result = window.process(toInput(j));
+        node.publish(channels.slot_state, toMsg(result, mode));
+        report(node.status(), result);
+      } catch (const std::exception& e) {
+        node.status().error(std::string("frame ") + std::to_string(j.frame) + ": " + e.what());
+      }
+    }
+  };
+  node.subscribeFrames<odometry_t>(channels.odometry, [&](const odometry_t& m) {
+    if (!joiner.addA(m.frame, OdometryPart{m.utime, fromMsg(m)}, nowSeconds()))
+      node.status().warn("ODOMETRY of frame " + std::to_string(m.frame) + " arrived after the frame was solved");
+    handleReady();
+  });
+  node.subscribeFrames<associations_t>(channels.associations, [&](const associations_t& m) {
+    int rejected = 0;
+    AssociationsPart part{m.utime, observationsFromMsg(m, &rejected)};
+    if (rejected) node.status().error(std::to_string(rejected) + " malformed boxes in ASSOCIATIONS of frame " + std::to_string(m.frame));
+    if (!joiner.addB(m.frame, std::move(part), nowSeconds()))
+      node.status().warn("ASSOCIATIONS of frame " + std::to_string(m.frame) + " arrived after the frame was solved");
+    handleReady();
+  });
+  node.every(0.01, handleReady);  // releases frames whose other part timed out
+  return node.run();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return runMain("dlslot-backend", [&] {
+    NodeOptions opts;
+    std::string mode, offline_in, offline_out;
+    CommandLine cl("dlslot-backend",
+                   "Sliding-window optimization of ego poses, landmarks and objects (DL-SLOT III-C): "
+                   "ODOMETRY + ASSOCIATIONS -> SLOT_STATE.");
+    opts.addTo(cl);
+    cl.option("--mode", &mode, "slot | two-stage | odometry-only (overrides backend.mode)");
+    cl.option("--offline", &offline_in, "read ODOMETRY and ASSOCIATIONS from this LCM log instead of the network");
+    cl.option("--out", &offline_out, "with --offline: write SLOT_STATE events to this LCM log");
+    if (!cl.parse(argc, argv)) return 0;
+    if (!offline_out.empty() && offline_in.empty()) throw std::invalid_argument("--out needs --offline");
+
+    ConfigSection root = loadConfig(opts.config);
+    Channels channels;
+    channels.read(root.section("channels"));
+    ConfigSection section = root.section("backend");
+    BackendConfig config = BackendConfig::read(section);
+    double join_timeout_s = 0;
+    section.get("join_timeout_s", join_timeout_s);
+    if (!(join_timeout_s > 0)) throw ConfigError(opts.config + ": backend.join_timeout_s: expected a time > 0 (s)");
+    section.finish();
+    if (!mode.empty()) config.mode = parseMode(mode);
+    if (opts.check_config) return 0;
+    if (!offline_in.empty()) return runOffline(config, channels, offline_in, offline_out);
+    return runLive(config, channels, opts, join_timeout_s);
+  });
+}

@@ -1,0 +1,55 @@
+#include "backend/marginalization_prior.hpp"
+
+#include "backend/pose_manifold.hpp"
+
+namespace dlslot::backend {
+
+MarginalizationPrior::MarginalizationPrior(std::vector<Vector7> x_lin, Eigen::MatrixXd J, Eigen::VectorXd r0)
+    : x_lin_(std::move(x_lin)), J_(std::move(J)), r0_(std::move(r0)) {
+  set_num_residuals(static_cast<int>(r0_.size()));
+  for (size_t i = 0; i < x_lin_.size(); ++i) mutable_parameter_block_sizes()->push_back(kPoseSize);
+  JtJ_.noalias() = J_.transpose() * J_;
+  Jtr0_.noalias() = J_.transpose() * r0_;
+}
+
+MarginalizationPrior* MarginalizationPrior::CreatePosePrior(const Pose& x0, const Matrix6& sqrt_info) {
+  return new MarginalizationPrior({toBlock(x0)}, sqrt_info, Eigen::VectorXd::Zero(6));
+}
+
+bool MarginalizationPrior::Evaluate(double const* const* x, double* residuals, double** jacobians) const {
+  const int n = numBlocks();
+  Eigen::VectorXd dx(kTangentSize * n);
+  for (int i = 0; i < n; ++i) dx.segment<6>(6 * i) = minus(fromBlock(x[i]), fromBlock(x_lin_[i].data()));
+  Eigen::Map<Eigen::VectorXd> r(residuals, numRows());
+  r = r0_ + J_ * dx;
+  if (!jacobians) return true;
+  for (int i = 0; i < n; ++i) {
+    if (!jacobians[i]) continue;
+    const Matrix6 M = minusJacobianAt(fromBlock(x[i]), fromBlock(x_lin_[i].data()));
+    const Eigen::MatrixXd J_tangent = J_.middleCols<6>(6 * i) * M;
+    tangentRowsToAmbient(J_tangent, x[i], jacobians[i]);
+  }
+  return true;
+}
+
+void MarginalizationPrior::linearize(double const* const* x, Eigen::MatrixXd& H, Eigen::VectorXd& g) const {
+  const int n = numBlocks();
+  Eigen::VectorXd dx(kTangentSize * n);
+  std::vector<Matrix6> M(n);
+  for (int i = 0; i < n; ++i) {
+    const Pose xi = fromBlock(x[i]), li = fromBlock(x_lin_[i].data());
+    dx.segment<6>(6 * i) = minus(xi, li);
+    M[i] = minusJacobianAt(xi, li);
+  }
+  // Jx = J blockdiag(M): H = M^T (J^T J) M, g = M^T J^T (r0 + J dx).
+  const Eigen::VectorXd g0 = Jtr0_ + JtJ_ * dx;
+  H.resize(6 * n, 6 * n);
+  g.resize(6 * n);
+  for (int i = 0; i < n; ++i) {
+    g.segment<6>(6 * i) = M[i].transpose() * g0.segment<6>(6 * i);
+    for (int j = 0; j < n; ++j)
+      H.block<6, 6>(6 * i, 6 * j) = M[i].transpose() * JtJ_.block<6, 6>(6 * i, 6 * j) * M[j];
+  }
+}
+
+}  // namespace dlslot::backend

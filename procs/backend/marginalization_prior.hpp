@@ -1,0 +1,42 @@
+// The prior left by marginalization (paper III-C: "applying Schur complement ... can reserve
+// the constraint that will be slided out of the window"), as in VINS-Mono: a linear residual
+//   r(x) = r0 + J (x [-] x_lin)
+// on the pose blocks that remain, with J and r0 from the Schur complement and x_lin the values
+// at which it was linearized. J stays fixed afterwards (first-estimate Jacobian), so the prior
+// never changes its information when its states move; only the manifold's own [-] is exact.
+#pragma once
+
+#include <ceres/cost_function.h>
+
+#include <vector>
+
+#include "backend/se3.hpp"
+
+namespace dlslot::backend {
+
+class MarginalizationPrior final : public ceres::CostFunction {
+ public:
+  // x_lin: one linearization point per block; J: rows x (6 * blocks); r0: rows.
+  MarginalizationPrior(std::vector<Vector7> x_lin, Eigen::MatrixXd J, Eigen::VectorXd r0);
+  // A prior on a single pose (e.g. the first ego pose, which fixes the gauge): r = S (x [-] x0).
+  static MarginalizationPrior* CreatePosePrior(const Pose& x0, const Matrix6& sqrt_info);
+
+  bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override;
+
+  // Gauss-Newton terms at x in the blocks' tangent spaces: H = Jx^T Jx and g = Jx^T r(x),
+  // without forming Jx^T Jx from the (dense) rows: J^T J and J^T r0 are kept from construction.
+  void linearize(double const* const* x, Eigen::MatrixXd& H, Eigen::VectorXd& g) const;
+
+  int numBlocks() const { return static_cast<int>(x_lin_.size()); }
+  int numRows() const { return static_cast<int>(r0_.size()); }
+  const std::vector<Vector7>& linearizationPoints() const { return x_lin_; }
+
+ private:
+  std::vector<Vector7> x_lin_;
+  Eigen::MatrixXd J_;
+  Eigen::VectorXd r0_;
+  Eigen::MatrixXd JtJ_;
+  Eigen::VectorXd Jtr0_;
+};
+
+}  // namespace dlslot::backend

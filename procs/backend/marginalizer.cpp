@@ -1,0 +1,149 @@
+#include "backend/marginalizer.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <unordered_map>
+
+#include "backend/marginalization_prior.hpp"
+#include "backend/pose_manifold.hpp"
+
+namespace dlslot::backend {
+namespace {
+
+// Ceres' robust-loss correction (Triggs et al.): with s = |r|^2 and rho(s), the corrected
+// residual and Jacobian give the same Gauss-Newton step as Ceres takes.
+void applyLoss(const ceres::LossFunction& loss, Eigen::VectorXd& r, Eigen::MatrixXd& J) {
+  const double s = r.squaredNorm();
+  double rho[3];
+  loss.Evaluate(s, rho);
+  const double sqrt_rho1 = std::sqrt(std::max(rho[1], 0.0));
+  if (s == 0.0 || rho[2] <= 0.0) {
+    r *= sqrt_rho1;
+    J *= sqrt_rho1;
+    return;
+  }
+  const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * s * rho[2] / rho[1]);
+  J = sqrt_rho1 * (J - (alpha / s) * r * (r.transpose() * J));
+  r *= sqrt_rho1 / (1.0 - alpha);
+}
+
+// A^-1 B for a symmetric positive semi-definite A: Cholesky, or a pseudo-inverse when A is
+// singular (a direction no factor constrains carries no information to pass on).
+Eigen::MatrixXd solveSpd(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
+  Eigen::LLT<Eigen::MatrixXd> llt(A);
+  if (llt.info() == Eigen::Success) return llt.solve(B);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(A);
+  const double eps = 1e-10 * std::max(1.0, es.eigenvalues().cwiseAbs().maxCoeff());
+  const Eigen::VectorXd inv = (es.eigenvalues().array() > eps).select(es.eigenvalues().cwiseInverse(), 0.0);
+  return es.eigenvectors() * inv.asDiagonal() * (es.eigenvectors().transpose() * B);
+}
+
+// H = J^T J and g = J^T r  ->  (J, r); J is square (upper triangular when H is definite).
+void factorize(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, Eigen::MatrixXd& J, Eigen::VectorXd& r) {
+  Eigen::LLT<Eigen::MatrixXd> llt(H);
+  if (llt.info() == Eigen::Success) {
+    J = llt.matrixU();
+    r = llt.matrixL().solve(g);
+    return;
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H);
+  const double eps = 1e-10 * std::max(1.0, es.eigenvalues().cwiseAbs().maxCoeff());
+  const Eigen::ArrayXd lambda = (es.eigenvalues().array() > eps).select(es.eigenvalues().array(), 0.0);
+  const Eigen::ArrayXd inv_sqrt = (lambda > 0).select(lambda.sqrt().inverse(), 0.0);
+  J = lambda.sqrt().matrix().asDiagonal() * es.eigenvectors().transpose();
+  r = inv_sqrt.matrix().asDiagonal() * (es.eigenvectors().transpose() * g);
+}
+
+}  // namespace
+
+std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>& factors,
+                                                const std::unordered_set<const double*>& leaving,
+                                                const std::unordered_set<const double*>& fixed) {
+  stats_ = Stats();
+  stats_.factors = static_cast<int>(factors.size());
+  // Order the estimated blocks: leaving ones first, then the ones that stay.
+  std::vector<double*> order, kept;
+  std::unordered_map<const double*, int> index;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (const Factor* f : factors) {
+      for (double* b : f->blocks) {
+        if (fixed.count(b) || index.count(b) || (leaving.count(b) > 0) != (pass == 0)) continue;
+        index[b] = static_cast<int>(order.size());
+        order.push_back(b);
+        if (pass == 1) kept.push_back(b);
+      }
+    }
+  }
+  const int n = static_cast<int>(order.size());
+  const int nm = 6 * (n - static_cast<int>(kept.size()));
+  const int nr = 6 * static_cast<int>(kept.size());
+  stats_.leaving_dim = nm;
+  stats_.kept_dim = nr;
+  if (nr == 0) return std::nullopt;
+
+  // Linearize every factor at the current estimate into the dense H, g.
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(nm + nr, nm + nr);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(nm + nr);
+  for (const Factor* f : factors) {
+    const int nb = static_cast<int>(f->blocks.size());
+    std::vector<int> at(nb);
+    for (int k = 0; k < nb; ++k) at[k] = fixed.count(f->blocks[k]) ? -1 : 6 * index.at(f->blocks[k]);
+    if (const auto* prior = dynamic_cast<const MarginalizationPrior*>(f->cost.get())) {
+      Eigen::MatrixXd Hf;
+      Eigen::VectorXd gf;
+      prior->linearize(f->blocks.data(), Hf, gf);
+      for (int a = 0; a < nb; ++a) {
+        if (at[a] < 0) continue;
+        g.segment(at[a], 6) += gf.segment<6>(6 * a);
+        for (int b = 0; b < nb; ++b)
+          if (at[b] >= 0) H.block<6, 6>(at[a], at[b]) += Hf.block<6, 6>(6 * a, 6 * b);
+      }
+      continue;
+    }
+    const int rows = f->cost->num_residuals();
+    Eigen::VectorXd r(rows);
+    std::vector<Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>> J_amb(nb);
+    std::vector<double*> jac_ptrs(nb);
+    for (int k = 0; k < nb; ++k) {
+      J_amb[k].resize(rows, 7);
+      jac_ptrs[k] = J_amb[k].data();
+    }
+    f->cost->Evaluate(f->blocks.data(), r.data(), jac_ptrs.data());
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(rows, 6 * nb);
+    for (int k = 0; k < nb; ++k)
+      if (at[k] >= 0) J.middleCols(6 * k, 6) = J_amb[k] * PoseManifold::plusJacobian(f->blocks[k]);
+    if (f->loss) applyLoss(*f->loss, r, J);
+    for (int a = 0; a < nb; ++a) {
+      if (at[a] < 0) continue;
+      g.segment(at[a], 6) += J.middleCols(6 * a, 6).transpose() * r;
+      for (int b = 0; b < nb; ++b)
+        if (at[b] >= 0) H.block(at[a], at[b], 6, 6) += J.middleCols(6 * a, 6).transpose() * J.middleCols(6 * b, 6);
+    }
+  }
+
+  // Schur complement onto the kept blocks.
+  Eigen::MatrixXd H_star = H.bottomRightCorner(nr, nr);
+  Eigen::VectorXd g_star = g.tail(nr);
+  if (nm > 0) {
+    Eigen::MatrixXd rhs(nm, nr + 1);
+    rhs << H.topRightCorner(nm, nr), g.head(nm);
+    const Eigen::MatrixXd X = solveSpd(H.topLeftCorner(nm, nm), rhs);
+    H_star.noalias() -= H.bottomLeftCorner(nr, nm) * X.leftCols(nr);
+    g_star.noalias() -= H.bottomLeftCorner(nr, nm) * X.col(nr);
+  }
+  H_star = 0.5 * (H_star + H_star.transpose());
+
+  Eigen::MatrixXd J_star;
+  Eigen::VectorXd r_star;
+  factorize(H_star, g_star, J_star, r_star);
+  std::vector<Vector7> x_lin;
+  x_lin.reserve(kept.size());
+  for (double* b : kept) x_lin.push_back(Eigen::Map<const Vector7>(b));
+  Factor prior;
+  prior.cost = std::make_shared<MarginalizationPrior>(std::move(x_lin), std::move(J_star), std::move(r_star));
+  prior.blocks = kept;
+  return prior;
+}
+
+}  // namespace dlslot::backend

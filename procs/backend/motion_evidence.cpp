@@ -1,0 +1,33 @@
+#include "backend/motion_evidence.hpp"
+
+namespace dlslot::backend {
+
+std::optional<double> fitSpeed(const std::vector<TimedPosition>& positions) {
+  if (positions.size() < 2) return std::nullopt;
+  double t_mean = 0;
+  Eigen::Vector2d p_mean = Eigen::Vector2d::Zero();
+  for (const auto& tp : positions) {
+    t_mean += tp.t;
+    p_mean += tp.p.head<2>();
+  }
+  t_mean /= positions.size();
+  p_mean /= positions.size();
+  double stt = 0;
+  Eigen::Vector2d stp = Eigen::Vector2d::Zero();
+  for (const auto& tp : positions) {
+    stt += (tp.t - t_mean) * (tp.t - t_mean);
+    stp += (tp.t - t_mean) * (tp.p.head<2>() - p_mean);
+  }
+  if (stt < 1e-12) return std::nullopt;
+  return (stp / stt).norm();
+}
+
+bool leftLandmark(const std::vector<Eigen::Vector3d>& positions, const Eigen::Vector3d& landmark, double distance,
+                  int n) {
+  if (n <= 0 || static_cast<int>(positions.size()) < n) return false;
+  for (size_t i = positions.size() - n; i < positions.size(); ++i)
+    if ((positions[i] - landmark).head<2>().norm() <= distance) return false;
+  return true;
+}
+
+}  // namespace dlslot::backend

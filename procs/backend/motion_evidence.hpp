@@ -1,0 +1,26 @@
+// The window's evidence for the static/dynamic decision (paper III-D: "we first use the
+// object's trajectory in the sliding window to preliminarily judge the dynamic or static
+// state"), and for a landmark that starts to move.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+namespace dlslot::backend {
+
+struct TimedPosition {
+  double t = 0;  // seconds
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();  // world frame
+};
+
+// Bird's-eye speed (m/s) of the least-squares line through the positions; nothing when they
+// span less than two distinct times.
+std::optional<double> fitSpeed(const std::vector<TimedPosition>& positions);
+
+// True when the last `n` positions all lie farther than `distance` (bird's-eye) from `landmark`
+// (false when there are fewer than n).
+bool leftLandmark(const std::vector<Eigen::Vector3d>& positions, const Eigen::Vector3d& landmark, double distance,
+                  int n);
+
+}  // namespace dlslot::backend

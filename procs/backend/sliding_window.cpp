@@ -1,0 +1,481 @@
+#include "backend/sliding_window.hpp"
+
+#include <ceres/ceres.h>
+
+#include <chrono>
+#include <stdexcept>
+
+#include "backend/constant_velocity_factor.hpp"
+#include "backend/landmark_observation_factor.hpp"
+#include "backend/marginalization_prior.hpp"
+#include "backend/motion_evidence.hpp"
+#include "backend/observation_factor.hpp"
+#include "backend/odometry_factor.hpp"
+#include "backend/pose_change_factor.hpp"
+
+namespace dlslot::backend {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+std::shared_ptr<ceres::LossFunction> makeLoss(const std::string& name, double scale) {
+  if (name == "huber") return std::make_shared<ceres::HuberLoss>(scale);
+  if (name == "cauchy") return std::make_shared<ceres::CauchyLoss>(scale);
+  return nullptr;
+}
+
+// SE(3) interpolation a * Exp(s Log(a^-1 b)) with [t; Log(R)] coordinates of a^-1 b.
+Pose interpolate(const Pose& a, const Pose& b, double s) {
+  const Vector6 d = logPose(a.inverse() * b);
+  Pose step = Pose::Identity();
+  step.linear() = expSO3(s * d.tail<3>()).toRotationMatrix();
+  step.translation() = s * d.head<3>();
+  return a * step;
+}
+
+// c^n for a per-frame pose change c (predicting an object n frames ahead).
+Pose power(const Pose& c, int n) {
+  Pose out = Pose::Identity();
+  for (int i = 0; i < n; ++i) out = out * c;
+  return out;
+}
+
+}  // namespace
+
+SlidingWindow::SlidingWindow(BackendConfig config)
+    : config_(std::move(config)), observation_loss_(makeLoss(config_.observation_loss, config_.observation_loss_scale)) {}
+
+SlidingWindow::~SlidingWindow() = default;
+
+BackendOutput SlidingWindow::process(const BackendInput& in) {
+  if (in.frame <= last_frame_)
+    throw std::invalid_argument("backend: frame " + std::to_string(in.frame) + " after frame " + std::to_string(last_frame_));
+  const auto t0 = Clock::now();
+  last_frame_ = in.frame;
+  BackendOutput out;
+  out.frame = in.frame;
+  out.utime = in.utime;
+  out.odometry_missing = !in.odometry.has_value();
+  out.associations_missing = in.associations_missing;
+
+  addEgoFrame(in);
+  if (config_.mode != Mode::kOdometryOnly) {
+    addObservations(in);
+    out.static_to_dynamic = switchMovingLandmarks();
+  }
+  solve(out);
+  out.ego_pose = fromBlock(frames_.back().pose->data());
+  if (static_cast<int>(frames_.size()) >= config_.window_size) {
+    const auto t1 = Clock::now();
+    out.smoothed = slide();
+    out.stats.marginalize_ms = msSince(t1);
+  }
+  out.stats.prior_dim = priorDimension();
+  out.stats.total_ms = msSince(t0);
+  return out;
+}
+
+// ---- step 1: the ego pose and its odometry factor (eq. 8) ----
+
+void SlidingWindow::addEgoFrame(const BackendInput& in) {
+  const bool have_odometry = in.odometry.has_value();
+  const Pose delta = have_odometry ? in.odometry->delta : last_delta_;
+  Pose X;
+  if (frames_.empty()) {
+    X = have_odometry ? in.odometry->pose : Pose::Identity();
+  } else if (config_.mode == Mode::kSlot || !have_odometry) {
+    X = fromBlock(frames_.back().pose->data()) * delta;
+  } else {
+    X = in.odometry->pose;  // two-stage / odometry-only: the odometry's pose as it is
+  }
+  EgoFrame f;
+  f.frame = in.frame;
+  f.utime = in.utime;
+  double* x = newBlock(f.pose, X);
+  double* x_prev = frames_.empty() ? nullptr : frames_.back().pose->data();
+  frames_.push_back(std::move(f));
+  last_delta_ = delta;
+
+  if (config_.mode != Mode::kSlot) {
+    fixed_.insert(x);
+    return;
+  }
+  if (!x_prev) {
+    // The first pose fixes the gauge (world = the first scan's frame).
+    addFactor(MarginalizationPrior::CreatePosePrior(X, sqrtInformation(config_.first_pose_sigma)), false, {x});
+    return;
+  }
+  Matrix6 S = sqrtInformation(config_.odometry_sigma);
+  if (have_odometry && config_.use_odometry_covariance) {
+    Eigen::LLT<Matrix6> llt(in.odometry->covariance);
+    // S = L^-1 with Sigma = L L^T gives S^T S = Sigma^-1.
+    if (llt.info() == Eigen::Success && in.odometry->covariance.allFinite())
+      S = llt.matrixL().solve(Matrix6::Identity());
+  }
+  if (!have_odometry || !in.odometry->ok) S /= config_.degraded_odometry_scale;
+  addFactor(OdometryFactor::Create(delta, S), false, {x_prev, x});
+}
+
+// ---- step 2: observations, eq. 9-11 with eq. 12's membership ----
+
+void SlidingWindow::addObservations(const BackendInput& in) {
+  const Pose X = fromBlock(frames_.back().pose->data());
+  for (const ObservationInput& obs : in.observations) {
+    if (obs.track_id < 0) continue;
+    Track& track = tracks_[obs.track_id];
+    if (track.observations.count(in.frame)) continue;  // one detection per track and frame
+    if (track.id < 0) {
+      track.id = obs.track_id;
+      first_seen_.emplace(obs.track_id, in.frame);
+    }
+    track.type = obs.box.type;
+    // Running mean of the box size, weighted towards recent boxes after a while.
+    track.size_samples = std::min(track.size_samples + 1, 20);
+    track.size += (obs.box.size - track.size) / track.size_samples;
+    track.last_seen = in.frame;
+    track.dynamic_guess = obs.dynamic_guess;
+    track.observations[in.frame] = Observation{alignedBox(track, X, obs.box), false};
+    if (!obs.initialized) continue;  // not in O_init yet: evidence only
+    if (track.model == TrackModel::kNotInGraph) startTrack(track, in.frame);
+    addTrackObservation(track, in.frame);
+  }
+}
+
+void SlidingWindow::startTrack(Track& track, int frame) {
+  // Static or dynamic from the positions of the trajectory in the window (III-D); the tracker's
+  // guess only when the window has too little of it.
+  std::vector<TimedPosition> positions;
+  for (const auto& [f, obs] : track.observations) {
+    const EgoFrame* ego = findFrame(f);
+    if (ego) positions.push_back({1e-6 * static_cast<double>(ego->utime), fromBlock(ego->pose->data()) * obs.b.translation()});
+  }
+  const std::optional<double> speed = fitSpeed(positions);
+  const bool dynamic = speed ? *speed > config_.static_max_speed : track.dynamic_guess;
+  track.model = dynamic ? TrackModel::kDynamic : TrackModel::kStatic;
+  if (!dynamic) newBlock(track.landmark, fromBlock(frames_.back().pose->data()) * track.observations.at(frame).b);
+}
+
+void SlidingWindow::addTrackObservation(Track& track, int frame) {
+  Observation& obs = track.observations.at(frame);
+  double* x = findFrame(frame)->pose->data();
+  const Pose X = fromBlock(x);
+  if (track.model == TrackModel::kStatic) {
+    addFactor(LandmarkObservationFactor::Create(obs.b, sqrtInformation(config_.landmark_sigma)), true,
+              {x, track.landmark->data()});
+  } else {
+    extendChain(track, frame, X * obs.b);
+    addFactor(ObservationFactor::Create(obs.b, sqrtInformation(config_.observation_sigma)), true,
+              {x, track.poses.at(frame)->data()});
+  }
+  obs.in_graph = true;
+}
+
+void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
+  if (track.poses.empty()) {
+    newBlock(track.poses[frame], o);
+    return;
+  }
+  // Frames the object was not seen in get poses too (interpolated), so the pose changes stay
+  // per frame and the object bridges the gap at constant velocity.
+  const int last = track.poses.rbegin()->first;
+  const Pose o_last = fromBlock(track.poses.rbegin()->second->data());
+  for (int f = last + 1; f <= frame; ++f) {
+    const Pose o_f = f == frame ? o : interpolate(o_last, o, double(f - last) / double(frame - last));
+    double* prev = track.poses.at(f - 1)->data();
+    double* cur = newBlock(track.poses[f], o_f);
+    double* change = newBlock(track.changes[f - 1], fromBlock(prev).inverse() * o_f);  // eq. 2
+    addFactor(PoseChangeFactor::Create(sqrtInformation(config_.pose_change_sigma)), false, {prev, cur, change});
+    auto before = track.changes.find(f - 2);
+    if (before != track.changes.end())
+      addFactor(ConstantVelocityFactor::Create(sqrtInformation(config_.constant_velocity_sigma)), false,
+                {before->second->data(), change});
+  }
+}
+
+// ---- step 3: a landmark that moves becomes a dynamic object ----
+
+int SlidingWindow::switchMovingLandmarks() {
+  int switched = 0;
+  for (auto& [id, track] : tracks_) {
+    if (track.model != TrackModel::kStatic) continue;
+    std::vector<Eigen::Vector3d> positions;
+    for (const auto& [f, obs] : track.observations)
+      if (obs.in_graph) positions.push_back(fromBlock(findFrame(f)->pose->data()) * obs.b.translation());
+    if (leftLandmark(positions, fromBlock(track.landmark->data()).translation(), config_.switch_distance,
+                     config_.switch_frames)) {
+      makeDynamic(track);
+      ++switched;
+    }
+  }
+  return switched;
+}
+
+void SlidingWindow::makeDynamic(Track& track) {
+  // The landmark's observations inside the window are re-added as dynamic observations; what
+  // older (marginalized) ones said about the ego poses stays: the landmark is marginalized out
+  // of the prior, not dropped.
+  double* L = track.landmark->data();
+  std::vector<const Factor*> priors;
+  for (const Factor& f : factors_)
+    if (f.touches(L) && dynamic_cast<const MarginalizationPrior*>(f.cost.get())) priors.push_back(&f);
+  std::optional<Factor> prior;
+  if (!priors.empty()) prior = marginalizer_.marginalize(priors, {L}, fixed_);
+  factors_.erase(std::remove_if(factors_.begin(), factors_.end(), [L](const Factor& f) { return f.touches(L); }),
+                 factors_.end());
+  if (prior) factors_.push_back(std::move(*prior));
+  track.landmark.reset();
+  track.model = TrackModel::kDynamic;
+  for (auto& [f, obs] : track.observations)
+    if (obs.in_graph) addTrackObservation(track, f);
+}
+
+// ---- step 4: solve eq. 12 ----
+
+void SlidingWindow::solve(BackendOutput& out) {
+  const auto t0 = Clock::now();
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(po);
+  int variable = 0;
+  for (double* b : liveBlocks()) {
+    problem.AddParameterBlock(b, kPoseSize, &manifold_);
+    if (fixed_.count(b)) {
+      problem.SetParameterBlockConstant(b);
+    } else {
+      ++variable;
+    }
+  }
+  for (const Factor& f : factors_) problem.AddResidualBlock(f.cost.get(), f.loss.get(), f.blocks);
+  out.stats.num_blocks = problem.NumParameterBlocks();
+  out.stats.num_factors = problem.NumResidualBlocks();
+  if (variable > 0 && !factors_.empty()) {
+    ceres::Solver::Options so;
+    so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    so.max_num_iterations = config_.max_iterations;
+    so.function_tolerance = config_.function_tolerance;
+    so.gradient_tolerance = config_.gradient_tolerance;
+    so.parameter_tolerance = config_.parameter_tolerance;
+    so.num_threads = 1;
+    so.logging_type = ceres::SILENT;
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+    out.stats.iterations = static_cast<int>(summary.iterations.size()) - 1;
+    out.stats.initial_cost = summary.initial_cost;
+    out.stats.final_cost = summary.final_cost;
+  }
+  out.stats.solve_ms = msSince(t0);
+  const auto t1 = Clock::now();
+  fillTracks(out, variable > 0 && config_.compute_covariance ? &problem : nullptr);
+  out.stats.covariance_ms = msSince(t1);
+}
+
+void SlidingWindow::fillTracks(BackendOutput& out, ceres::Problem* problem) {
+  const int t = frames_.back().frame;
+  double* x_t = frames_.back().pose->data();
+  std::vector<std::pair<const double*, const double*>> wanted;
+  std::vector<std::pair<TrackEstimate, const double*>> estimates;
+  for (const auto& [id, track] : tracks_) {
+    if (track.model == TrackModel::kNotInGraph) continue;
+    TrackEstimate e;
+    e.id = id;
+    e.type = track.type;
+    e.size = track.size;
+    e.dynamic = track.model == TrackModel::kDynamic;
+    e.age = t - first_seen_.at(id);
+    e.last_seen_frame = track.last_seen;
+    for (const auto& [f, obs] : track.observations) e.num_observations += obs.in_graph;
+    const double* block = nullptr;
+    if (!e.dynamic) {
+      block = track.landmark->data();
+      e.pose = fromBlock(block);
+    } else {
+      const auto& [f_last, o_last] = *track.poses.rbegin();
+      block = f_last == t ? o_last->data() : nullptr;
+      e.pose = *predictedPose(track);
+      if (!track.changes.empty()) {
+        // Velocities from the latest pose change c_f^{f+1} = o_f^-1 o_{f+1} over its time.
+        const auto& [f, c_block] = *track.changes.rbegin();
+        const EgoFrame *a = findFrame(f), *b = findFrame(f + 1);
+        const double dt = a && b ? 1e-6 * static_cast<double>(b->utime - a->utime) : 0.0;
+        if (dt > 0) {
+          const Eigen::Matrix3d R_f = fromBlock(track.poses.at(f)->data()).linear();
+          const Vector6 c = logPose(fromBlock(c_block->data()));
+          e.velocity = R_f * c.head<3>() / dt;
+          e.angular_velocity = R_f * c.tail<3>() / dt;
+        }
+      }
+    }
+    if (block && problem && !fixed_.count(block)) wanted.emplace_back(block, block);
+    estimates.emplace_back(e, block);
+  }
+  if (problem) {
+    const bool ego_estimated = !fixed_.count(x_t);
+    if (ego_estimated) wanted.emplace_back(x_t, x_t);
+    ceres::Covariance::Options co;
+    co.algorithm_type = ceres::SPARSE_QR;
+    co.num_threads = 1;
+    ceres::Covariance covariance(co);
+    if (!wanted.empty() && covariance.Compute(wanted, problem)) {
+      if (ego_estimated) covariance.GetCovarianceBlockInTangentSpace(x_t, x_t, out.ego_covariance.data());
+      for (auto& [e, block] : estimates)
+        if (block && !fixed_.count(block)) covariance.GetCovarianceBlockInTangentSpace(block, block, e.covariance.data());
+    }
+  }
+  for (auto& [e, block] : estimates) out.tracks.push_back(std::move(e));
+}
+
+// ---- step 5: slide the window ----
+
+SmoothedPose SlidingWindow::slide() {
+  EgoFrame& oldest = frames_.front();
+  const int s = oldest.frame;
+  SmoothedPose smoothed{s, oldest.utime, fromBlock(oldest.pose->data())};
+  std::unordered_set<const double*> leaving{oldest.pose->data()};
+  std::vector<Track*> left_view;
+  for (auto& [id, track] : tracks_) {
+    if (track.model == TrackModel::kNotInGraph) continue;
+    bool seen_later = false;
+    for (auto it = track.observations.upper_bound(s); it != track.observations.end(); ++it) seen_later |= it->second.in_graph;
+    if (!seen_later) left_view.push_back(&track);
+    if (track.model == TrackModel::kStatic) {
+      if (!seen_later) leaving.insert(track.landmark->data());
+      continue;
+    }
+    for (const auto& [f, block] : track.poses)
+      if (f <= s || !seen_later) leaving.insert(block->data());
+    for (const auto& [f, block] : track.changes)
+      if (f <= s || !seen_later) leaving.insert(block->data());
+  }
+  marginalizeBlocks(leaving);
+
+  for (auto& [id, track] : tracks_) {
+    track.poses.erase(track.poses.begin(), track.poses.upper_bound(s));
+    track.changes.erase(track.changes.begin(), track.changes.upper_bound(s));
+    track.observations.erase(track.observations.begin(), track.observations.upper_bound(s));
+  }
+  for (Track* track : left_view) {
+    track->model = TrackModel::kNotInGraph;
+    track->landmark.reset();
+    track->poses.clear();
+    track->changes.clear();
+  }
+  // Tracks with nothing left in the window are forgotten (first_seen_ keeps their age).
+  for (auto it = tracks_.begin(); it != tracks_.end();)
+    it = it->second.observations.empty() && it->second.model == TrackModel::kNotInGraph ? tracks_.erase(it) : std::next(it);
+  fixed_.erase(oldest.pose->data());
+  frames_.pop_front();
+  return smoothed;
+}
+
+void SlidingWindow::marginalizeBlocks(const std::unordered_set<const double*>& leaving) {
+  std::vector<const Factor*> touching;
+  for (const Factor& f : factors_)
+    for (double* b : f.blocks)
+      if (leaving.count(b)) {
+        touching.push_back(&f);
+        break;
+      }
+  if (touching.empty()) return;
+  std::optional<Factor> prior = marginalizer_.marginalize(touching, leaving, fixed_);
+  factors_.erase(std::remove_if(factors_.begin(), factors_.end(),
+                                [&](const Factor& f) {
+                                  for (double* b : f.blocks)
+                                    if (leaving.count(b)) return true;
+                                  return false;
+                                }),
+                 factors_.end());
+  if (prior) factors_.push_back(std::move(*prior));
+}
+
+// ---- helpers ----
+
+void SlidingWindow::addFactor(ceres::CostFunction* cost, bool robust, std::vector<double*> blocks) {
+  factors_.push_back(Factor{std::shared_ptr<ceres::CostFunction>(cost), robust ? observation_loss_ : nullptr,
+                            std::move(blocks)});
+}
+
+double* SlidingWindow::newBlock(Block& slot, const Pose& value) {
+  slot = std::make_unique<Vector7>(toBlock(value));
+  return slot->data();
+}
+
+const SlidingWindow::EgoFrame* SlidingWindow::findFrame(int frame) const {
+  for (const EgoFrame& f : frames_)
+    if (f.frame == frame) return &f;
+  return nullptr;
+}
+
+Pose SlidingWindow::alignedBox(const Track& track, const Pose& X, const Box& box) const {
+  // A box and the box turned by pi are the same box; detectors flip headings. Keep the heading
+  // closest to what the track already has (its estimate, else its last observation).
+  std::optional<double> reference;
+  if (const auto predicted = predictedPose(track)) {
+    reference = yawOf(predicted->linear());
+  } else if (!track.observations.empty()) {
+    const auto& [f, obs] = *track.observations.rbegin();
+    if (const EgoFrame* ego = findFrame(f)) reference = yawOf(fromBlock(ego->pose->data()).linear() * obs.b.linear());
+  }
+  Box b = box;
+  if (reference && std::abs(wrapAngle(yawOf(X.linear() * b.pose().linear()) - *reference)) > M_PI / 2)
+    b.yaw = wrapAngle(b.yaw + M_PI);
+  return b.pose();
+}
+
+std::optional<Pose> SlidingWindow::predictedPose(const Track& track) const {
+  if (track.model == TrackModel::kStatic) return fromBlock(track.landmark->data());
+  if (track.model != TrackModel::kDynamic) return std::nullopt;
+  const auto& [f_last, o_last] = *track.poses.rbegin();
+  const int ahead = frames_.back().frame - f_last;
+  if (ahead <= 0 || track.changes.empty()) return fromBlock(o_last->data());
+  return fromBlock(o_last->data()) * power(fromBlock(track.changes.rbegin()->second->data()), ahead);
+}
+
+std::vector<double*> SlidingWindow::liveBlocks() const {
+  std::vector<double*> blocks;
+  for (const EgoFrame& f : frames_) blocks.push_back(f.pose->data());
+  for (const auto& [id, track] : tracks_) {
+    if (track.landmark) blocks.push_back(track.landmark->data());
+    for (const auto& [f, b] : track.poses) blocks.push_back(b->data());
+    for (const auto& [f, b] : track.changes) blocks.push_back(b->data());
+  }
+  return blocks;
+}
+
+std::vector<int> SlidingWindow::windowFrames() const {
+  std::vector<int> out;
+  for (const EgoFrame& f : frames_) out.push_back(f.frame);
+  return out;
+}
+
+std::optional<Pose> SlidingWindow::egoPose(int frame) const {
+  const EgoFrame* f = findFrame(frame);
+  if (!f) return std::nullopt;
+  return fromBlock(f->pose->data());
+}
+
+std::optional<Pose> SlidingWindow::objectPose(int track_id, int frame) const {
+  auto it = tracks_.find(track_id);
+  if (it == tracks_.end()) return std::nullopt;
+  const Track& track = it->second;
+  if (track.model == TrackModel::kStatic) return fromBlock(track.landmark->data());
+  auto p = track.poses.find(frame);
+  if (p == track.poses.end()) return std::nullopt;
+  return fromBlock(p->second->data());
+}
+
+SlidingWindow::TrackModel SlidingWindow::trackModel(int track_id) const {
+  auto it = tracks_.find(track_id);
+  return it == tracks_.end() ? TrackModel::kNotInGraph : it->second.model;
+}
+
+int SlidingWindow::priorDimension() const {
+  int dim = 0;
+  for (const Factor& f : factors_)
+    if (const auto* p = dynamic_cast<const MarginalizationPrior*>(f.cost.get())) dim += 6 * p->numBlocks();
+  return dim;
+}
+
+}  // namespace dlslot::backend

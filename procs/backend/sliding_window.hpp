@@ -1,0 +1,109 @@
+// The sliding-window estimator of DL-SLOT (paper III-C, III-D, eq. 8-12): the ego poses X of
+// the last k frames, each initialized object either as one static landmark pose or, when it
+// moves, as a pose per frame o plus pose-change vertices c (eq. 2), all solved together with
+// Ceres. Per frame:
+//   1. add X_t, predicted from X_{t-1} and the odometry's T (eq. 8 factor);
+//   2. add the frame's observations: O_init get observation factors (eq. 9 / landmark), O_aso
+//      pose-change factors (eq. 10), O_cons constant-velocity factors (eq. 11);
+//   3. turn landmarks that started to move into dynamic objects;
+//   4. solve eq. 12;
+//   5. when the window is full, marginalize the oldest frame (its ego pose, object poses and
+//      pose changes, and the objects that left the view) into the prior.
+#pragma once
+
+#include <deque>
+#include <map>
+#include <memory>
+#include <unordered_set>
+#include <vector>
+
+#include "backend/backend_config.hpp"
+#include "backend/backend_types.hpp"
+#include "backend/factor.hpp"
+#include "backend/marginalizer.hpp"
+#include "backend/pose_manifold.hpp"
+
+namespace ceres {
+class Problem;
+}
+
+namespace dlslot::backend {
+
+class SlidingWindow {
+ public:
+  explicit SlidingWindow(BackendConfig config);
+  ~SlidingWindow();
+
+  // Handles one frame; frames must come in increasing order (std::invalid_argument otherwise).
+  BackendOutput process(const BackendInput& input);
+
+  enum class TrackModel { kNotInGraph, kStatic, kDynamic };
+
+  // Current estimates, for tests and tools.
+  const BackendConfig& config() const { return config_; }
+  std::vector<int> windowFrames() const;
+  std::optional<Pose> egoPose(int frame) const;
+  // A static object's landmark, or a dynamic object's pose at `frame` (when in the window).
+  std::optional<Pose> objectPose(int track_id, int frame) const;
+  TrackModel trackModel(int track_id) const;
+  int priorDimension() const;
+
+ private:
+  using Block = std::unique_ptr<Vector7>;
+  struct EgoFrame {
+    int frame = 0;
+    int64_t utime = 0;
+    Block pose;
+  };
+  struct Observation {
+    Pose b = Pose::Identity();  // T_lidar_object with the yaw aligned to the track
+    bool in_graph = false;      // initialized, so it has a factor (eq. 12's O_init)
+  };
+  struct Track {
+    int id = -1;
+    std::string type;
+    Eigen::Vector3d size = Eigen::Vector3d::Zero();
+    int size_samples = 0;
+    int last_seen = -1;
+    bool dynamic_guess = false;
+    TrackModel model = TrackModel::kNotInGraph;
+    Block landmark;                 // static: one pose for the whole window
+    std::map<int, Block> poses;     // dynamic: frame -> o_frame
+    std::map<int, Block> changes;   // dynamic: frame f -> c_f^{f+1}
+    std::map<int, Observation> observations;  // frames in the window
+  };
+
+  void addEgoFrame(const BackendInput& in);
+  void addObservations(const BackendInput& in);
+  void startTrack(Track& track, int frame);
+  void addTrackObservation(Track& track, int frame);
+  void extendChain(Track& track, int frame, const Pose& o);
+  int switchMovingLandmarks();
+  void makeDynamic(Track& track);
+  void solve(BackendOutput& out);
+  void fillTracks(BackendOutput& out, ceres::Problem* problem);
+  SmoothedPose slide();
+
+  void addFactor(ceres::CostFunction* cost, bool robust, std::vector<double*> blocks);
+  // Marginalizes `leaving` with every factor touching it and replaces those by the prior.
+  void marginalizeBlocks(const std::unordered_set<const double*>& leaving);
+  double* newBlock(Block& slot, const Pose& value);
+  const EgoFrame* findFrame(int frame) const;
+  Pose alignedBox(const Track& track, const Pose& X, const Box& box) const;
+  std::optional<Pose> predictedPose(const Track& track) const;
+  std::vector<double*> liveBlocks() const;
+
+  BackendConfig config_;
+  PoseManifold manifold_;
+  Marginalizer marginalizer_;
+  std::shared_ptr<ceres::LossFunction> observation_loss_;
+  std::deque<EgoFrame> frames_;
+  std::map<int, Track> tracks_;
+  std::map<int, int> first_seen_;  // track id -> frame it was first seen (for its age)
+  std::vector<Factor> factors_;
+  std::unordered_set<const double*> fixed_;  // ego poses held at the odometry's (two-stage)
+  Pose last_delta_ = Pose::Identity();       // for a frame without odometry (constant velocity)
+  int last_frame_ = -1;
+};
+
+}  // namespace dlslot::backend

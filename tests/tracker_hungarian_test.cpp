@@ -1,5 +1,5 @@
 // The Hungarian solver against brute force on random matrices up to 8x8, square, rectangular
-// and empty.
+// and empty; the gated assignment of eq. 6-7 likewise.
 #include <gtest/gtest.h>
 
 #include <functional>
@@ -8,7 +8,9 @@
 
 #include "hungarian.hpp"
 
+using dlslot::tracker::Admissible;
 using dlslot::tracker::solveAssignment;
+using dlslot::tracker::solveGatedAssignment;
 
 namespace {
 
@@ -50,6 +52,27 @@ double checkedCost(const Eigen::MatrixXd& c, const std::vector<int>& assignment)
   for (int h : hits) EXPECT_LE(h, 1);
   EXPECT_EQ(pairs, std::min(c.rows(), c.cols()));
   return sum;
+}
+
+// Best (most admissible pairs, then least cost) over every one-to-one set of admissible pairs.
+std::pair<int, double> bruteForceGated(const Eigen::MatrixXd& c, const Admissible& ok) {
+  std::vector<char> used(c.cols(), 0);
+  std::pair<int, double> best{0, 0.0};
+  std::function<void(int, int, double)> go = [&](int row, int pairs, double sum) {
+    if (row == c.rows()) {
+      if (pairs > best.first || (pairs == best.first && sum < best.second)) best = {pairs, sum};
+      return;
+    }
+    go(row + 1, pairs, sum);  // row left unmatched
+    for (int j = 0; j < c.cols(); ++j) {
+      if (used[j] || !ok(row, j)) continue;
+      used[j] = 1;
+      go(row + 1, pairs + 1, sum + c(row, j));
+      used[j] = 0;
+    }
+  };
+  go(0, 0, 0.0);
+  return best;
 }
 
 }  // namespace
@@ -115,4 +138,50 @@ TEST(TrackerHungarian, RejectsNonFiniteCosts) {
   EXPECT_THROW(solveAssignment(c), std::invalid_argument);
   c(0, 1) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(solveAssignment(c), std::invalid_argument);
+}
+
+TEST(TrackerHungarian, GatedAssignmentEqualsBruteForce) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int rows = 0; rows <= 7; ++rows) {
+    for (int cols = 0; cols <= 7; ++cols) {
+      for (int trial = 0; trial < 6; ++trial) {
+        Eigen::MatrixXd c(rows, cols);
+        Admissible ok(rows, cols);
+        const double density = 0.15 + 0.15 * trial;
+        for (int i = 0; i < rows; ++i)
+          for (int j = 0; j < cols; ++j) {
+            c(i, j) = 5.0 * u(rng) - 1.0;  // negative costs too
+            ok(i, j) = u(rng) < density;
+          }
+        const std::vector<int> a = solveGatedAssignment(c, ok);
+        ASSERT_EQ(a.size(), static_cast<size_t>(rows));
+        std::vector<int> hits(cols, 0);
+        int pairs = 0;
+        double sum = 0;
+        for (int i = 0; i < rows; ++i) {
+          if (a[i] < 0) continue;
+          EXPECT_TRUE(ok(i, a[i]));
+          EXPECT_EQ(++hits[a[i]], 1);
+          ++pairs;
+          sum += c(i, a[i]);
+        }
+        const auto best = bruteForceGated(c, ok);
+        EXPECT_EQ(pairs, best.first) << rows << "x" << cols << " trial " << trial;
+        EXPECT_NEAR(sum, best.second, 1e-9) << rows << "x" << cols << " trial " << trial;
+      }
+    }
+  }
+}
+
+TEST(TrackerHungarian, GatedAssignmentPrefersMorePairsOverLowerCost) {
+  // Row 0 could take column 0 cheaply, but then row 1 (admissible only with column 0) is left out.
+  Eigen::MatrixXd c(2, 2);
+  c << 0.0, 10.0,
+       5.0, 0.0;
+  Admissible ok(2, 2);
+  ok << true, true,
+        true, false;
+  EXPECT_EQ(solveGatedAssignment(c, ok), (std::vector<int>{1, 0}));
+  EXPECT_THROW(solveGatedAssignment(c, Admissible(1, 2)), std::invalid_argument);
 }

@@ -1,7 +1,9 @@
 #include "hungarian.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 
 namespace dlslot::tracker {
@@ -66,6 +68,17 @@ std::vector<int> solveWide(const Eigen::MatrixXd& c) {
   return col_of_row;
 }
 
+// Union-find over rows (0..U-1) and columns (U..U+V-1).
+struct Components {
+  std::vector<int> parent;
+  explicit Components(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  }
+  void join(int a, int b) { parent[find(a)] = find(b); }
+};
+
 }  // namespace
 
 std::vector<int> solveAssignment(const Eigen::MatrixXd& cost) {
@@ -77,6 +90,49 @@ std::vector<int> solveAssignment(const Eigen::MatrixXd& cost) {
   const std::vector<int> row_of_col = solveWide(cost.transpose());
   std::vector<int> col_of_row(cost.rows(), -1);
   for (int j = 0; j < static_cast<int>(row_of_col.size()); ++j) col_of_row[row_of_col[j]] = j;
+  return col_of_row;
+}
+
+std::vector<int> solveGatedAssignment(const Eigen::MatrixXd& cost, const Admissible& admissible) {
+  if (cost.rows() != admissible.rows() || cost.cols() != admissible.cols())
+    throw std::invalid_argument("solveGatedAssignment: cost and admissible differ in size");
+  const int U = static_cast<int>(cost.rows()), V = static_cast<int>(cost.cols());
+  Components comp(U + V);
+  for (int u = 0; u < U; ++u)
+    for (int v = 0; v < V; ++v)
+      if (admissible(u, v)) comp.join(u, U + v);
+
+  std::vector<std::vector<int>> rows_of(U + V), cols_of(U + V);
+  for (int u = 0; u < U; ++u) rows_of[comp.find(u)].push_back(u);
+  for (int v = 0; v < V; ++v) cols_of[comp.find(U + v)].push_back(v);
+
+  std::vector<int> col_of_row(U, -1);
+  for (int root = 0; root < U + V; ++root) {
+    const std::vector<int>& rows = rows_of[root];
+    const std::vector<int>& cols = cols_of[root];
+    if (rows.empty() || cols.empty()) continue;
+    if (rows.size() == 1 && cols.size() == 1) {  // the common case: one trajectory, one detection
+      col_of_row[rows[0]] = cols[0];
+      continue;
+    }
+    // Shift the admissible costs to >= 0; an inadmissible pair then costs more than any set of
+    // admissible pairs could, so the solver first maximises the number of admissible pairs.
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int u : rows)
+      for (int v : cols)
+        if (admissible(u, v)) {
+          lo = std::min(lo, cost(u, v));
+          hi = std::max(hi, cost(u, v));
+        }
+    const double forbidden = std::min(rows.size(), cols.size()) * (hi - lo) + 1.0;
+    Eigen::MatrixXd c(rows.size(), cols.size());
+    for (size_t i = 0; i < rows.size(); ++i)
+      for (size_t j = 0; j < cols.size(); ++j)
+        c(i, j) = admissible(rows[i], cols[j]) ? cost(rows[i], cols[j]) - lo : forbidden;
+    const std::vector<int> a = solveAssignment(c);
+    for (size_t i = 0; i < rows.size(); ++i)
+      if (a[i] >= 0 && admissible(rows[i], cols[a[i]])) col_of_row[rows[i]] = cols[a[i]];
+  }
   return col_of_row;
 }
 

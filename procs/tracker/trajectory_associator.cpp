@@ -94,28 +94,25 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
     a.box_world = detections[v].transformed(X_t);  // eq. 1: o_t = X_t * b_t
   }
 
-  // Eq. 6-7: a pair is admissible when its squared bird's-eye distance is below theta and the
-  // classes are compatible. The binary score alone leaves ties (several admissible pairs per
-  // row); the cost breaks them without ever trading an admissible pair away: an admissible pair
-  // costs less than 1, an inadmissible one more than any full set of admissible pairs could, so
-  // the assignment first maximises the number of admissible matches (the paper's score). Among
-  // those it prefers initialized trajectories, whose prediction is a fit, over young ones
-  // predicting with a last position that may be a false positive (a matching cascade in one
-  // solve), and then nearer pairs.
-  const double forbidden = std::min(U, V) + 1.0;
-  Eigen::MatrixXd cost = Eigen::MatrixXd::Constant(U, V, forbidden);
+  // Eq. 6-7: a pair is admissible (score 1) when its squared bird's-eye distance is below theta
+  // and the classes are compatible; the assignment maximises the number of admissible matches.
+  // The binary score leaves ties, broken by a cost: initialized trajectories, whose prediction is
+  // a fit, before young ones predicting with a last position that may be a false positive (a
+  // matching cascade in one solve), then nearer pairs.
+  Eigen::MatrixXd cost(U, V);
+  Admissible admissible(U, V);
   for (int u = 0; u < U; ++u) {
     for (int v = 0; v < V; ++v) {
       const double d2 = (predicted[u].head<2>() - out.associations[v].box_world.center.head<2>()).squaredNorm();
-      if (d2 < config_.gate_sq_m2 && kitti::classesCompatible(trajectories_[u].last_box.type, detections[v].type))
-        cost(u, v) = 0.5 * (d2 / config_.gate_sq_m2 + (initialized[u] ? 0.0 : 1.0));
+      admissible(u, v) =
+          d2 < config_.gate_sq_m2 && kitti::classesCompatible(trajectories_[u].last_box.type, detections[v].type);
+      cost(u, v) = d2 / config_.gate_sq_m2 + (initialized[u] ? 0.0 : 1.0);
     }
   }
-  const std::vector<int> assignment = solveAssignment(cost);
-
+  const std::vector<int> assignment = solveGatedAssignment(cost, admissible);
   std::vector<int> trajectory_of(V, -1);
   for (int u = 0; u < U; ++u)
-    if (assignment[u] >= 0 && cost(u, assignment[u]) < 1.0) trajectory_of[assignment[u]] = u;
+    if (assignment[u] >= 0) trajectory_of[assignment[u]] = u;
 
   for (int v = 0; v < V; ++v) {
     Association& a = out.associations[v];

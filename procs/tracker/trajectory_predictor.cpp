@@ -81,10 +81,23 @@ Prediction predictPolynomial(const std::vector<TrajectoryPoint>& points, double 
 
 double windowDisplacement(const std::vector<TrajectoryPoint>& points) {
   if (points.size() < 2 || points.back().time_s <= points.front().time_s) return 0.0;
-  const NormalEquations eq(points, 1);
-  const Eigen::Matrix<double, 2, 2> theta = eq.AtA.ldlt().solve(eq.Atb);
-  // Slope row times the span (-1 .. 1 in normalised time).
-  return 2.0 * theta.row(1).norm();
+  // Least-squares velocity (the slope of a line through the window) times the window's span.
+  double t_mean = 0;
+  Eigen::Vector2d p_mean = Eigen::Vector2d::Zero();
+  for (const TrajectoryPoint& p : points) {
+    t_mean += p.time_s;
+    p_mean += p.position.head<2>();
+  }
+  t_mean /= static_cast<double>(points.size());
+  p_mean /= static_cast<double>(points.size());
+  double stt = 0;
+  Eigen::Vector2d stp = Eigen::Vector2d::Zero();
+  for (const TrajectoryPoint& p : points) {
+    const double dt = p.time_s - t_mean;
+    stt += dt * dt;
+    stp += dt * (p.position.head<2>() - p_mean);
+  }
+  return (stp / stt).norm() * (points.back().time_s - points.front().time_s);
 }
 
 }  // namespace dlslot::tracker

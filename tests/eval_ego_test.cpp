@@ -58,12 +58,12 @@ TEST(EvalEgo, IdenticalTrajectoriesGiveZeroEverywhere) {
   EXPECT_NEAR(*m.ate_rmse_m, 0.0, 1e-9);
   EXPECT_NEAR(*m.ate_unaligned_rmse_m, 0.0, 1e-12);
   EXPECT_NEAR(*m.rpe1_t_m, 0.0, 1e-12);
-  EXPECT_NEAR(*m.rpe1_r_deg, 0.0, 1e-5);  // acos near 1 is coarse: ~1e-6 rad of rounding
+  EXPECT_NEAR(*m.rpe1_r_deg, 0.0, 1e-12);
   EXPECT_NEAR(*m.rpe10_t_m, 0.0, 1e-12);
   EXPECT_NEAR(*m.t_rel_pct, 0.0, 1e-9);
-  EXPECT_NEAR(*m.r_rel_deg_per_100m, 0.0, 1e-5);
+  EXPECT_NEAR(*m.r_rel_deg_per_100m, 0.0, 1e-12);
   EXPECT_NEAR(*m.t_rel_short_pct, 0.0, 1e-9);
-  EXPECT_NEAR(*m.r_rel_short_deg_per_100m, 0.0, 1e-4);
+  EXPECT_NEAR(*m.r_rel_short_deg_per_100m, 0.0, 1e-12);
 }
 
 TEST(EvalEgo, ConstantOffsetHasKnownAteBeforeAlignmentAndZeroAfter) {
@@ -135,7 +135,7 @@ TEST(EvalEgo, ScaleDriftGivesTheDevkitsTranslationError) {
   EXPECT_NEAR(*m.t_rel_pct, expected(kDevkitLengths), 1e-9);
   EXPECT_NEAR(*m.t_rel_short_pct, expected(kShortLengths), 1e-9);
   EXPECT_NEAR(*m.t_rel_pct, 1.0, 0.01);  // about the 1 % drift
-  EXPECT_NEAR(*m.r_rel_deg_per_100m, 0.0, 1e-5);
+  EXPECT_NEAR(*m.r_rel_deg_per_100m, 0.0, 1e-12);
   // Segments of length 100: first frames 0, 10, ..., 890 (the last needs frame first + 101 <= 999).
   EXPECT_EQ(m.devkit->lengths.front(), 100);
   EXPECT_EQ(m.devkit->lengths.back(), 800);

@@ -21,9 +21,11 @@ void requireSameFrames(const Trajectory& est, const Trajectory& gt) {
                                 std::to_string(est.size()) + " vs " + std::to_string(gt.size()) + " poses)");
 }
 
-// Rotation angle of R, as the devkit computes it (acos of the clamped trace).
+// Rotation angle of R. The devkit's acos(0.5 (trace - 1)) in a form that stays accurate for the
+// tiny angles of good estimates (acos near 1 loses half the digits).
 double rotationAngle(const Eigen::Matrix3d& R) {
-  return std::acos(std::clamp(0.5 * (R.trace() - 1.0), -1.0, 1.0));
+  const Eigen::Vector3d axis_sin(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1));  // 2 sin(angle) axis
+  return std::atan2(0.5 * axis_sin.norm(), 0.5 * (R.trace() - 1.0));
 }
 
 std::vector<Eigen::Vector3d> positions(const Trajectory& t) {

@@ -14,7 +14,7 @@ namespace {
 
 using Series = std::vector<Eigen::Vector2d>;
 
-const cv::Scalar kTruthColour(0, 0, 0);
+const cv::Scalar kTruthColour(170, 170, 170);
 const std::vector<cv::Scalar> kColours = {{200, 90, 30}, {40, 40, 220}, {40, 160, 40}, {180, 40, 180}, {0, 140, 230}};
 
 // A data-to-pixel mapping with axes, ticks and a legend.
@@ -67,7 +67,9 @@ class Plot {
     cv::rectangle(image_, {kLeft, kTop}, {kWidth - kRight, kHeight - kBottom}, ink, 1);
     cv::putText(image_, x_label, {kWidth / 2 - 40, kHeight - 12}, cv::FONT_HERSHEY_SIMPLEX, 0.5, ink, 1, cv::LINE_AA);
     cv::putText(image_, y_label, {8, kTop - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.5, ink, 1, cv::LINE_AA);
-    cv::putText(image_, title, {kLeft + 150, kTop - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.55, ink, 1, cv::LINE_AA);
+    int baseline = 0;
+    const cv::Size size = cv::getTextSize(title, cv::FONT_HERSHEY_SIMPLEX, 0.6, 1, &baseline);
+    cv::putText(image_, title, {(kWidth - size.width) / 2, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.6, ink, 1, cv::LINE_AA);
   }
 
   void line(const Series& s, const cv::Scalar& colour, int thickness, const std::string& name) {
@@ -95,7 +97,7 @@ class Plot {
       if (m * p >= raw) return m * p;
     return 10.0 * p;
   }
-  static constexpr int kWidth = 1000, kHeight = 800, kLeft = 70, kRight = 20, kTop = 40, kBottom = 50;
+  static constexpr int kWidth = 1000, kHeight = 800, kLeft = 70, kRight = 20, kTop = 60, kBottom = 50;
   cv::Mat image_;
   Eigen::Vector2d lo_, hi_, scale_;
   std::vector<std::pair<std::string, cv::Scalar>> legend_;
@@ -126,9 +128,12 @@ void plotTrajectories(const std::string& path, const std::map<std::string, Traje
   if (!lo.allFinite()) lo = hi = Eigen::Vector2d::Zero();
   Plot plot(lo, hi, true);
   plot.axes("x [m]", "y [m]", "trajectories, bird's-eye view");
+  // The ground truth wide and light underneath, so an estimate on top of it stays visible.
   size_t c = 0;
-  for (const auto& [name, s] : series)
-    plot.line(s, truth && name == "ground truth" ? kTruthColour : kColours[c++ % kColours.size()], 2, name);
+  for (const auto& [name, s] : series) {
+    const bool is_truth = truth && name == "ground truth";
+    plot.line(s, is_truth ? kTruthColour : kColours[c++ % kColours.size()], is_truth ? 6 : 2, name);
+  }
   plot.save(path);
 }
 

@@ -65,7 +65,7 @@ class LogReader {
       run_.frame_counts[*c] = 0;
     int64_t end_of_last = 0, count = 0;
     while (const lcm::LogEvent* ev = log.readNextEvent()) {
-      // LCM resynchronises silently on garbage; an event must start where the previous one ended.
+      // Newer LCM versions skip garbage silently; an event must start where the previous one ended.
       const int64_t end = std::ftell(log.getFilePtr());
       const int64_t start = end - kEventHeaderBytes - static_cast<int64_t>(ev->channel.size()) - ev->datalen;
       if (start != end_of_last)
@@ -75,9 +75,9 @@ class LogReader {
       handle(*ev, count++);
     }
     if (end_of_last != static_cast<int64_t>(file_size))
-      throw InputError(path_, 0, "truncated or corrupt log: bytes " + std::to_string(end_of_last) + ".." +
-                                     std::to_string(file_size) + " after event " + std::to_string(count) +
-                                     " do not form a complete event");
+      throw InputError(path_, 0, "truncated or corrupt log: the bytes from offset " + std::to_string(end_of_last) +
+                                     " to " + std::to_string(file_size) + " (after " + std::to_string(count) +
+                                     " complete events) do not form a complete event");
     if (count == 0) throw InputError(path_, 0, "the log holds no events");
     finishSlot();
     return std::move(run_);

@@ -34,7 +34,7 @@ std::string assignVelocities(RunData& run, double dynamic_speed_mps) {
           "consecutive labelled positions put in the world with the ground-truth poses; tracks: " +
           std::string(run.track_velocities_given ? "the system's own velocity estimates"
                                                  : "differences of positions put in the world with the system's poses") +
-          "; dynamic = labelled speed >= " + speed + " m/s";
+          "; dynamic = labels whose mean speed over their life is >= " + speed + " m/s";
   } else {
     finiteDifferenceVelocities(frames, Side::Truth, VelocityFrame::Sensor, true);
     finiteDifferenceVelocities(frames, Side::Tracks, VelocityFrame::Sensor, true);

@@ -22,8 +22,9 @@ enum class Side { Truth, Tracks };
 void finiteDifferenceVelocities(std::vector<TrackingFrame>& frames, Side side, VelocityFrame velocity_frame,
                                 bool overwrite);
 
-// Labels are dynamic when their velocity (World) is at least min_speed_mps. In the Sensor frame
-// every object moves relative to the sensor, so every label with a velocity counts.
+// World: a label is dynamic when its mean speed over its whole life (first to last sighting in
+// the world) is at least min_speed_mps. Sensor: every object moves relative to the sensor, so
+// every label with a velocity counts.
 void markDynamicLabels(std::vector<TrackingFrame>& frames, VelocityFrame velocity_frame, double min_speed_mps);
 
 }  // namespace dlslot::eval

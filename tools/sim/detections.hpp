@@ -1,0 +1,31 @@
+// The simulated 3D object detector: each object is found with a probability that grows with its
+// number of points, its box comes back with noise on position (growing with range), yaw (and
+// now and then a heading flipped by pi) and size, vans are sometimes called cars; false positives
+// come from random structure and, persistently, from a few poles, trees and bushes that "look
+// like" pedestrians. Scores are SECOND-like probabilities: high for well-seen objects, low for
+// false positives. Rows use the KITTI tracking result format (truncated and occluded -1);
+// true positives carry the object's track id (for analysis only), false positives -1.
+#pragma once
+
+#include <vector>
+
+#include "dlslot/kitti.hpp"
+#include "rng.hpp"
+#include "sensor.hpp"
+
+namespace dlslot::sim {
+
+struct DetectorTarget {
+  Box box;            // lidar frame (type set)
+  int track_id = -1;  // -1 when not (yet) labelled
+  int points = 0;
+};
+
+// Which structures are persistent false-positive sources, chosen once per sequence.
+std::vector<bool> chooseGhosts(const World& world, const DetectorSpec& spec, uint64_t key);
+
+std::vector<kitti::LabelRow> detect(int frame, const std::vector<DetectorTarget>& targets, const Scan& scan,
+                                    const World& world, const std::vector<bool>& ghosts, const Pose& T_map_lidar,
+                                    const DetectorSpec& spec, const kitti::Calib& calib, Rng& rng);
+
+}  // namespace dlslot::sim

@@ -1,0 +1,61 @@
+#include "simulation.hpp"
+
+#include <stdexcept>
+
+#include "calib.hpp"
+#include "detections.hpp"
+#include "labels.hpp"
+
+namespace dlslot::sim {
+
+Simulation::Simulation(const Scenario& scenario)
+    : scenario_(scenario), world_(buildWorld(scenario_)), motion_(simulateMotion(scenario_, world_)),
+      calib_(kittiCalib()), ghosts_(chooseGhosts(world_, scenario_.detector, streamKey({scenario_.seed, 5}))),
+      track_id_(motion_.agents.size(), -1) {}
+
+std::vector<Pose> Simulation::lidarPoses() const {
+  std::vector<Pose> poses;
+  const Pose T_world_map = motion_.ego.front().inverse();
+  for (const Pose& T : motion_.ego) poses.push_back(T_world_map * T);
+  return poses;
+}
+
+Simulation::FrameData Simulation::frame(int index, int threads) {
+  if (index != next_frame_) throw std::logic_error("Simulation::frame: frames must be made in order");
+  ++next_frame_;
+  FrameData fd;
+  ScanInput& in = fd.input;
+  in.world = &world_;
+  in.T_map_lidar = motion_.ego[index];
+  in.key = streamKey({scenario_.seed, 6, static_cast<uint64_t>(index)});
+  const Pose T_lidar_map = in.T_map_lidar.inverse();
+  // Objects within the lidar's range (with a margin for their size) take part in this frame.
+  std::vector<int> agent_of;
+  for (size_t i = 0; i < motion_.agents.size(); ++i) {
+    const Box b = agentBox(motion_.agents[i], index, *world_.ground);
+    if ((b.center - in.T_map_lidar.translation()).head<2>().norm() > scenario_.sensor.max_range_m + 10.0) continue;
+    agentSolids(motion_.agents[i], static_cast<int>(agent_of.size()), index, *world_.ground, in.object_solids);
+    in.object_boxes.push_back(b);
+    agent_of.push_back(static_cast<int>(i));
+  }
+  fd.scan = scan(scenario_.sensor, in, threads);
+
+  std::vector<DetectorTarget> targets;
+  for (size_t k = 0; k < agent_of.size(); ++k) {
+    Box box = in.object_boxes[k].transformed(T_lidar_map);
+    if (box.center.head<2>().norm() > scenario_.sensor.max_range_m) continue;
+    const ObjectView& view = fd.scan.views[k];
+    int& id = track_id_[agent_of[k]];
+    const bool dontcare = view.points < scenario_.labels.min_points;
+    if (!dontcare && id < 0) id = next_track_id_++;
+    // DontCare rows keep the real 3D box so an evaluator can ignore matches there in bird's-eye view.
+    fd.labels.push_back(labelRow(index, dontcare ? -1 : id, dontcare ? "DontCare" : box.type, box, calib_,
+                                 occlusionLevel(view)));
+    targets.push_back({box, id, view.points});
+  }
+  Rng rng(streamKey({scenario_.seed, 7, static_cast<uint64_t>(index)}));
+  fd.detections = detect(index, targets, fd.scan, world_, ghosts_, in.T_map_lidar, scenario_.detector, calib_, rng);
+  return fd;
+}
+
+}  // namespace dlslot::sim

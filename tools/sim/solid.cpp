@@ -1,0 +1,212 @@
+#include "solid.hpp"
+
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <vector>
+
+namespace dlslot::sim {
+
+Solid Solid::box(const Eigen::Vector3d& center, const Eigen::Vector3d& size, double yaw, float reflectivity) {
+  Solid s;
+  s.kind = SolidKind::Box;
+  s.center = center;
+  s.half = 0.5 * size;
+  s.cos_yaw = std::cos(yaw);
+  s.sin_yaw = std::sin(yaw);
+  s.reflectivity = reflectivity;
+  return s;
+}
+
+Solid Solid::cylinder(const Eigen::Vector2d& axis, double z_lo, double z_hi, double radius, float reflectivity) {
+  Solid s;
+  s.kind = SolidKind::Cylinder;
+  s.center = Eigen::Vector3d(axis.x(), axis.y(), 0.5 * (z_lo + z_hi));
+  s.half = Eigen::Vector3d(radius, radius, 0.5 * (z_hi - z_lo));
+  s.reflectivity = reflectivity;
+  return s;
+}
+
+Solid Solid::sphere(const Eigen::Vector3d& center, double radius, float reflectivity) {
+  Solid s;
+  s.kind = SolidKind::Sphere;
+  s.center = center;
+  s.half = Eigen::Vector3d::Constant(radius);
+  s.reflectivity = reflectivity;
+  return s;
+}
+
+namespace {
+
+bool intersectBox(const Solid& b, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double& s) {
+  const double rx = o.x() - b.center.x(), ry = o.y() - b.center.y();
+  const double lo[3] = {b.cos_yaw * rx + b.sin_yaw * ry, -b.sin_yaw * rx + b.cos_yaw * ry, o.z() - b.center.z()};
+  const double ld[3] = {b.cos_yaw * d.x() + b.sin_yaw * d.y(), -b.sin_yaw * d.x() + b.cos_yaw * d.y(), d.z()};
+  double t_in = -std::numeric_limits<double>::infinity(), t_out = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(ld[i]) < 1e-12) {
+      if (std::abs(lo[i]) > b.half[i]) return false;
+      continue;
+    }
+    const double inv = 1.0 / ld[i];
+    double t1 = (-b.half[i] - lo[i]) * inv, t2 = (b.half[i] - lo[i]) * inv;
+    if (t1 > t2) std::swap(t1, t2);
+    t_in = std::max(t_in, t1);
+    t_out = std::min(t_out, t2);
+    if (t_in > t_out) return false;
+  }
+  if (t_in <= 0 || t_in >= max_s) return false;
+  s = t_in;
+  return true;
+}
+
+bool intersectCylinder(const Solid& c, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double& s) {
+  const double ox = o.x() - c.center.x(), oy = o.y() - c.center.y(), oz = o.z() - c.center.z();
+  const double r = c.half.x(), hz = c.half.z();
+  double best = max_s;
+  const double a = d.x() * d.x() + d.y() * d.y();
+  if (a > 1e-12) {  // the side
+    const double bh = ox * d.x() + oy * d.y();
+    const double cc = ox * ox + oy * oy - r * r;
+    const double disc = bh * bh - a * cc;
+    if (disc >= 0) {
+      const double t = (-bh - std::sqrt(disc)) / a;
+      if (t > 0 && t < best && std::abs(oz + t * d.z()) <= hz) best = t;
+    }
+  }
+  if (std::abs(d.z()) > 1e-12) {  // the caps
+    for (double cap : {hz, -hz}) {
+      const double t = (cap - oz) / d.z();
+      if (t > 0 && t < best) {
+        const double px = ox + t * d.x(), py = oy + t * d.y();
+        if (px * px + py * py <= r * r) best = t;
+      }
+    }
+  }
+  if (best >= max_s) return false;
+  s = best;
+  return true;
+}
+
+bool intersectSphere(const Solid& sp, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double& s) {
+  const Eigen::Vector3d oc = o - sp.center;
+  const double bh = oc.dot(d), cc = oc.squaredNorm() - sp.half.x() * sp.half.x();
+  const double disc = bh * bh - cc;
+  if (disc < 0 || cc < 0) return false;
+  const double t = -bh - std::sqrt(disc);
+  if (t <= 0 || t >= max_s) return false;
+  s = t;
+  return true;
+}
+
+// Footprint as a polygon (boxes) or a circle, for separating-axis tests in the plane.
+struct Footprint {
+  bool circle = false;
+  Eigen::Vector2d c;
+  double r = 0;
+  std::array<Eigen::Vector2d, 4> corners;
+  std::array<Eigen::Vector2d, 2> axes;
+};
+
+Footprint footprintOf(const Solid& s, double grow) {
+  Footprint f;
+  f.c = s.center.head<2>();
+  if (s.kind != SolidKind::Box) {
+    f.circle = true;
+    f.r = s.half.x() + grow;
+    return f;
+  }
+  const Eigen::Vector2d ax(s.cos_yaw, s.sin_yaw), ay(-s.sin_yaw, s.cos_yaw);
+  const double hx = s.half.x() + grow, hy = s.half.y() + grow;
+  f.axes = {ax, ay};
+  f.corners = {f.c + hx * ax + hy * ay, f.c + hx * ax - hy * ay, f.c - hx * ax - hy * ay, f.c - hx * ax + hy * ay};
+  return f;
+}
+
+void project(const Footprint& f, const Eigen::Vector2d& axis, double& lo, double& hi) {
+  if (f.circle) {
+    const double m = f.c.dot(axis);
+    lo = m - f.r;
+    hi = m + f.r;
+    return;
+  }
+  lo = hi = f.corners[0].dot(axis);
+  for (int i = 1; i < 4; ++i) {
+    const double v = f.corners[i].dot(axis);
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+}
+
+}  // namespace
+
+bool intersect(const Solid& solid, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double& s) {
+  switch (solid.kind) {
+    case SolidKind::Box: return intersectBox(solid, o, d, max_s, s);
+    case SolidKind::Cylinder: return intersectCylinder(solid, o, d, max_s, s);
+    case SolidKind::Sphere: return intersectSphere(solid, o, d, max_s, s);
+  }
+  return false;
+}
+
+Eigen::Vector3d normalAt(const Solid& solid, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d r = p - solid.center;
+  switch (solid.kind) {
+    case SolidKind::Box: {
+      const Eigen::Vector3d local(solid.cos_yaw * r.x() + solid.sin_yaw * r.y(),
+                                  -solid.sin_yaw * r.x() + solid.cos_yaw * r.y(), r.z());
+      int axis = 0;
+      double best = -1;
+      for (int i = 0; i < 3; ++i) {
+        const double v = std::abs(local[i]) / solid.half[i];
+        if (v > best) {
+          best = v;
+          axis = i;
+        }
+      }
+      Eigen::Vector3d n_local = Eigen::Vector3d::Zero();
+      n_local[axis] = local[axis] >= 0 ? 1.0 : -1.0;
+      return {solid.cos_yaw * n_local.x() - solid.sin_yaw * n_local.y(),
+              solid.sin_yaw * n_local.x() + solid.cos_yaw * n_local.y(), n_local.z()};
+    }
+    case SolidKind::Cylinder: {
+      if (std::abs(r.z()) >= solid.half.z() - 1e-6) return Eigen::Vector3d(0, 0, r.z() > 0 ? 1.0 : -1.0);
+      const Eigen::Vector2d radial = r.head<2>();
+      const double n = radial.norm();
+      return n > 0 ? Eigen::Vector3d(radial.x() / n, radial.y() / n, 0.0) : Eigen::Vector3d::UnitX();
+    }
+    case SolidKind::Sphere: {
+      const double n = r.norm();
+      return n > 0 ? Eigen::Vector3d(r / n) : Eigen::Vector3d::UnitZ();
+    }
+  }
+  return Eigen::Vector3d::UnitZ();
+}
+
+bool overlaps(const Solid& a, const Solid& b, double margin) {
+  if (a.zMax() < b.zMin() || b.zMax() < a.zMin()) return false;
+  const Footprint fa = footprintOf(a, margin), fb = footprintOf(b, 0.0);
+  if ((fa.c - fb.c).norm() > a.radiusXY() + b.radiusXY() + 1.5 * margin) return false;
+  if (fa.circle && fb.circle) return (fa.c - fb.c).norm() <= fa.r + fb.r;
+  // Separating axes: the boxes' edge normals, and for a circle the direction to the nearest corner.
+  std::vector<Eigen::Vector2d> axes;
+  for (const Footprint* f : {&fa, &fb})
+    if (!f->circle) axes.insert(axes.end(), f->axes.begin(), f->axes.end());
+  for (const Footprint* f : {&fa, &fb}) {
+    if (!f->circle) continue;
+    const Footprint& other = f == &fa ? fb : fa;
+    Eigen::Vector2d nearest = other.corners[0];
+    for (const auto& c : other.corners)
+      if ((c - f->c).squaredNorm() < (nearest - f->c).squaredNorm()) nearest = c;
+    if ((nearest - f->c).norm() > 1e-9) axes.push_back((nearest - f->c).normalized());
+  }
+  for (const Eigen::Vector2d& axis : axes) {
+    double alo, ahi, blo, bhi;
+    project(fa, axis, alo, ahi);
+    project(fb, axis, blo, bhi);
+    if (ahi < blo || bhi < alo) return false;
+  }
+  return true;
+}
+
+}  // namespace dlslot::sim

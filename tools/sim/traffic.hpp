@@ -1,0 +1,40 @@
+// The objects and the ego vehicle over time. Vehicles, cyclists and pedestrians move along their
+// lanes, routes or crossings with a speed profile (cruise, speed changes, stops, traffic lights)
+// and keep their distance to whoever is ahead on the same lane (the interaction term of the
+// Intelligent Driver Model). Objects whose paths would still overlap another's (or the ego's, or
+// a structure) at some frame are removed, so no two solids ever intersect. Parked vehicles stand
+// along the roads' parking strips.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "dlslot/types.hpp"
+#include "world.hpp"
+
+namespace dlslot::sim {
+
+struct Agent {
+  std::string type;
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();  // l, w, h
+  std::vector<Solid> parts;                         // in the box's own frame
+  bool parked = false;
+  // Per frame: the box's footprint centre (map frame), heading and speed.
+  std::vector<Eigen::Vector2d> xy;
+  std::vector<double> heading, speed;
+};
+
+struct Motion {
+  std::vector<Agent> agents;
+  std::vector<Pose> ego;  // T_map_lidar per frame
+  int removed = 0;        // objects dropped because their paths would overlap
+};
+
+Motion simulateMotion(const Scenario& scenario, const World& world);
+
+// The agent's box in the map frame at a frame (geometric centre: ground height + h/2).
+Box agentBox(const Agent& agent, int frame, const Ground& ground);
+// Its solids in the map frame at that frame, appended to `out` with owner = `index`.
+void agentSolids(const Agent& agent, int index, int frame, const Ground& ground, std::vector<Solid>& out);
+
+}  // namespace dlslot::sim

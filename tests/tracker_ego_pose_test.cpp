@@ -67,6 +67,18 @@ TEST(TrackerEgoPose, WithoutBackendTheOdometryPose) {
   EXPECT_TRUE(e.X.isApprox(odo.pose[3]));
 }
 
+TEST(TrackerEgoPose, AScanTheOdometryNeverSawIsBridgedByItsPoses) {
+  EgoPoseChain chain;
+  const Odometry odo(6);
+  for (int f : {0, 1, 2, 3, 5}) chain.addOdometry(f, odo.pose[f], odo.delta[f]);  // no scan 4
+  const Pose X3 = motion(3, 0.2);
+  chain.addOptimized(3, X3);
+  const EgoPose e = chain.poseAt(5);
+  EXPECT_EQ(e.source, PoseSource::Odometry);
+  EXPECT_TRUE(e.X.isApprox(X3 * odo.pose[3].inverse() * odo.pose[5]));
+  EXPECT_TRUE(e.X.isApprox(X3 * odo.delta[4] * odo.delta[5]));
+}
+
 TEST(TrackerEgoPose, MissingOdometryRepeatsTheLastMotion) {
   EgoPoseChain chain;
   const Odometry odo(6);

@@ -40,21 +40,26 @@ EgoPose EgoPoseChain::poseAt(int frame) const {
     out = {odo->second, PoseSource::Odometry};
   }
 
+  // T_f^{f+1} * ... * T_{t-1}^t from the deltas. A scan the odometry never saw (a frame gap)
+  // leaves a hole: its own poses still give the motion, X_t = X_f * inv(O_f) * O_t.
+  bool complete = true;
+  for (int f = from + 1; f <= frame && complete; ++f) complete = odometry_delta_.count(f) > 0;
+  if (complete) {
+    for (int f = from + 1; f <= frame; ++f) out.X = out.X * odometry_delta_.at(f);
+    return out;
+  }
+  auto o_from = odometry_pose_.find(from), o_to = odometry_pose_.find(frame);
+  if (o_from != odometry_pose_.end() && o_to != odometry_pose_.end()) {
+    out.X = out.X * o_from->second.inverse() * o_to->second;
+    return out;
+  }
+  // The odometry of this scan is missing: repeat the last motion known (constant velocity).
+  out.source = PoseSource::Predicted;
   const Pose* last_delta = nullptr;
+  if (auto before = odometry_delta_.find(from); before != odometry_delta_.end()) last_delta = &before->second;
   for (int f = from + 1; f <= frame; ++f) {
-    auto d = odometry_delta_.find(f);
-    if (d != odometry_delta_.end()) {
-      last_delta = &d->second;
-    } else {
-      out.source = PoseSource::Predicted;
-      if (!last_delta) {
-        // No motion seen since the chain's start: take the one that led to it, if known.
-        auto before = odometry_delta_.find(from);
-        if (before == odometry_delta_.end()) continue;  // standing still is the only guess
-        last_delta = &before->second;
-      }
-    }
-    out.X = out.X * *last_delta;
+    if (auto d = odometry_delta_.find(f); d != odometry_delta_.end()) last_delta = &d->second;
+    if (last_delta) out.X = out.X * *last_delta;  // with no motion known, standing still
   }
   return out;
 }

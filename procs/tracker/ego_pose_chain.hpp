@@ -1,6 +1,7 @@
 // The ego pose X_t that puts the detections of scan t in the world frame (eq. 1): the
 // backend's optimized pose when it has one for t, else the last optimized pose chained with the
-// odometry's relative motions since, X_t = X_f * T_f^{f+1} * ... * T_{t-1}^t.
+// odometry's relative motions since, X_t = X_f * T_f^{f+1} * ... * T_{t-1}^t (across a scan the
+// odometry never saw, with its own poses: X_t = X_f * inv(O_f) * O_t).
 #pragma once
 
 #include <map>
@@ -12,7 +13,7 @@ namespace dlslot::tracker {
 
 enum class PoseSource {
   Slot,       // the backend's optimized pose of this very scan
-  Odometry,   // chained from the last optimized pose (or the odometry's own pose) with odometry
+  Odometry,   // the last optimized pose (or the odometry's own pose) chained with odometry
   Predicted,  // odometry of some scan missing: its motion repeated (constant velocity)
 };
 const char* poseSourceName(PoseSource s);  // "slot" | "odometry" | "predicted"

@@ -1,0 +1,196 @@
+// dlslot-tracker started for real, fed over LCM in lockstep like the pipeline does (DETECTIONS
+// and ODOMETRY of scan t, then SLOT_STATE of t once ASSOCIATIONS t is out), with malformed
+// boxes, an empty scan, a scan whose ODOMETRY never comes, a skipped scan and an undecodable
+// message. Runs inside a private network namespace (see tests/CMakeLists.txt).
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <limits>
+#include <regex>
+#include <sstream>
+
+#include "dlslot/associations_t.hpp"
+#include "dlslot/convert.hpp"
+#include "dlslot/detections_t.hpp"
+#include "dlslot/odometry_t.hpp"
+#include "dlslot/process_status_t.hpp"
+#include "dlslot/slot_state_t.hpp"
+#include "process_harness.hpp"
+
+using namespace dlslot;
+using namespace dlslot::test;
+
+namespace {
+
+struct Listener {
+  std::vector<associations_t> associations;
+  process_status_t status;
+  bool has_status = false;
+  void onAssociations(const lcm::ReceiveBuffer*, const std::string&, const associations_t* m) { associations.push_back(*m); }
+  void onStatus(const lcm::ReceiveBuffer*, const std::string&, const process_status_t* m) {
+    if (m->name != "tracker") return;
+    status = *m;
+    has_status = true;
+  }
+};
+
+bool handleUntil(lcm::LCM& lcm, const std::function<bool()>& pred, double timeout_s) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (!pred()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    lcm.handleTimeout(20);
+  }
+  return true;
+}
+
+// The shipped config with a short join timeout, so the missing-ODOMETRY case is quick.
+std::string configWithTimeout(const std::string& dir, double timeout_s) {
+  std::ifstream in(config());
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = std::regex_replace(ss.str(), std::regex("join_timeout_s: [0-9.]+"),
+                                              "join_timeout_s: " + std::to_string(timeout_s));
+  const std::string path = dir + "/dlslot.yaml";
+  std::ofstream(path) << text;
+  return path;
+}
+
+int64_t counter(const process_status_t& s, const std::string& name) {
+  for (int i = 0; i < s.num_counters; ++i)
+    if (s.counter_names[i] == name) return s.counter_values[i];
+  return 0;
+}
+
+Pose egoAt(int frame) {
+  Pose X = Pose::Identity();
+  X.linear() = Eigen::AngleAxisd(0.02 * frame, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  X.translation() << 1.0 * frame, 0.1 * frame, 0;
+  return X;
+}
+
+}  // namespace
+
+TEST(TrackerProcess, RunsInAPrivateNetwork) { EXPECT_TRUE(insidePrivateNetwork()); }
+
+TEST(TrackerProcess, LockstepFramesWithFaults) {
+  const std::string dir = scratchDir();
+  ChildProcess tracker({bin("dlslot-tracker"), "--config", configWithTimeout(dir, 0.4)}, dir + "/tracker.out");
+  lcm::LCM lcm;
+  ASSERT_TRUE(lcm.good());
+  Listener listen;
+  lcm.subscribe("ASSOCIATIONS", &Listener::onAssociations, &listen);
+  lcm.subscribe("PROCESS_STATUS", &Listener::onStatus, &listen);
+  ASSERT_TRUE(handleUntil(lcm, [&] { return listen.has_status; }, 10.0)) << tracker.output();
+
+  // A car at 10 m/s in the world; the ego vehicle drives and turns.
+  auto carWorld = [](int f) { return Eigen::Vector3d(15 + 1.0 * f, 4, -0.8); };
+  const std::vector<int> frames = {0, 1, 2, 3, 4, 5, 6, 7, 8, 10, 11, 12};  // 9 never comes
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int f : frames) {
+    const Pose X = egoAt(f);
+    detections_t det;
+    det.utime = 1000000 + f * 100000;
+    det.frame = f;
+    if (f != 5) {  // scan 5 has no detections
+      Box car;
+      car.center = X.inverse() * carWorld(f);
+      car.size << 4.2, 1.8, 1.5;
+      car.type = "Car";
+      if (f == 3) {  // two malformed boxes before the car
+        box_t bad = toMsg(car);
+        bad.center[1] = nan;
+        det.boxes.push_back(bad);
+        bad = toMsg(car);
+        bad.size[0] = 0;
+        det.boxes.push_back(bad);
+      }
+      det.boxes.push_back(toMsg(car));
+    }
+    det.num_boxes = static_cast<int32_t>(det.boxes.size());
+    lcm.publish("DETECTIONS", &det);
+    if (f == 4) {
+      const uint8_t garbage[7] = {1, 2, 3, 4, 5, 6, 7};
+      lcm.publish("DETECTIONS", garbage, sizeof garbage);
+    }
+    if (f != 7) {  // ODOMETRY of scan 7 never comes: the tracker must time out and go on
+      odometry_t odo{};
+      odo.utime = det.utime;
+      odo.frame = f;
+      odo.pose = toMsg(X);
+      odo.delta = toMsg(f == 0 ? Pose::Identity() : Pose(egoAt(f - 1).inverse() * X));
+      lcm.publish("ODOMETRY", &odo);
+    }
+    ASSERT_TRUE(handleUntil(lcm, [&] { return !listen.associations.empty() && listen.associations.back().frame == f; }, 5.0))
+        << "no ASSOCIATIONS for frame " << f << "\n" << tracker.output();
+    // The backend's answer: the true pose (so the next scan's pose is chained from it).
+    slot_state_t slot{};
+    slot.utime = det.utime;
+    slot.frame = f;
+    slot.mode = "slot";
+    slot.ego_pose = toMsg(X);
+    lcm.publish("SLOT_STATE", &slot);
+  }
+  ASSERT_TRUE(handleUntil(lcm, [&] { return listen.has_status && listen.status.last_frame == 12; }, 3.0));
+  const int stop_code = tracker.stop();
+  EXPECT_EQ(stop_code, 0) << tracker.output();
+
+  ASSERT_EQ(listen.associations.size(), frames.size());
+  int track_id = -1;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const associations_t& a = listen.associations[i];
+    const int f = frames[i];
+    EXPECT_EQ(a.frame, f);
+    EXPECT_EQ(a.utime, 1000000 + f * 100000);
+    ASSERT_EQ(a.num_timings, 1);
+    EXPECT_EQ(a.timings[0].name, "total");
+    if (f == 5) {
+      EXPECT_EQ(a.num_associations, 0);
+      continue;
+    }
+    ASSERT_EQ(a.num_associations, 1) << f;
+    const association_t& as = a.associations[0];
+    EXPECT_EQ(as.detection_index, f == 3 ? 2 : 0);
+    EXPECT_EQ(a.num_rejected, f == 3 ? 2 : 0);
+    if (track_id < 0) track_id = as.track_id;
+    EXPECT_EQ(as.track_id, track_id) << f;
+    EXPECT_EQ(as.box_world.id, track_id);
+    // eq. 1 with the ego pose used; exact when that pose is the truth.
+    const Pose used = fromMsg(a.ego_pose);
+    EXPECT_NEAR((fromMsg(as.box_world).center - used * fromMsg(as.box_lidar).center).norm(), 0, 1e-6);
+    if (f == 7) {
+      EXPECT_EQ(a.ego_pose_source, "predicted");
+    } else {
+      EXPECT_EQ(a.ego_pose_source, "odometry");
+      EXPECT_NEAR((fromMsg(as.box_world).center - carWorld(f)).norm(), 0, 1e-6) << f;
+    }
+    EXPECT_EQ(as.initialized, as.num_observations > 3) << f;
+    EXPECT_EQ(as.has_prediction, f > 0);
+  }
+  EXPECT_TRUE(listen.associations.back().associations[0].initialized);
+  EXPECT_TRUE(listen.associations.back().associations[0].is_dynamic);
+
+  const process_status_t& s = listen.status;
+  EXPECT_EQ(s.frames_handled, static_cast<int64_t>(frames.size()));
+  EXPECT_GE(s.decode_errors, 1);
+  EXPECT_GE(s.timeouts, 1);
+  EXPECT_GE(s.frame_gaps, 1);
+  EXPECT_EQ(counter(s, "rejected_detections"), 2);
+  EXPECT_EQ(counter(s, "odometry_missing"), 1);
+  EXPECT_EQ(counter(s, "tracks_started"), 1);
+}
+
+TEST(TrackerProcess, BadConfigIsRefused) {
+  const std::string dir = scratchDir();
+  const std::string path = dir + "/bad.yaml";
+  {
+    std::ifstream in(config());
+    std::stringstream ss;
+    ss << in.rdbuf();
+    std::ofstream(path) << std::regex_replace(ss.str(), std::regex("predictor: polynomial"), "predictor: kalman");
+  }
+  ChildProcess tracker({bin("dlslot-tracker"), "--config", path, "--check-config"}, dir + "/tracker.out");
+  EXPECT_EQ(tracker.wait(10), 2);
+  EXPECT_NE(tracker.output().find("predictor"), std::string::npos) << tracker.output();
+  ChildProcess ok({bin("dlslot-tracker"), "--config", config(), "--check-config"}, dir + "/ok.out");
+  EXPECT_EQ(ok.wait(10), 0) << ok.output();
+}

@@ -8,6 +8,7 @@
 
 #include "dlslot/input_error.hpp"
 #include "ego_metrics.hpp"
+#include "evaluation.hpp"
 #include "trajectory.hpp"
 
 using namespace dlslot;
@@ -224,4 +225,23 @@ TEST(EvalEgo, BadTrajectoryFilesNameFileAndLine) {
   EXPECT_THROW(readTrajectory((dir / "missing.txt").string(), TrajectoryFormat::Kitti), InputError);
   EXPECT_THROW(parseTrajectoryFormat("euroc"), std::invalid_argument);
   std::filesystem::remove_all(dir);
+}
+
+TEST(EvalEgo, ARunStartingLaterInTheSequenceIsComparedInItsOwnWorld) {
+  // The run starts at frame 10: its world is the lidar frame of scan 10.
+  const Trajectory gt = curvedDrive(40);
+  Trajectory est;
+  const Pose world_change = gt.poses[10].inverse();
+  for (size_t i = 10; i < gt.size(); ++i) est.add(gt.frames[i], gt.stamps[i], world_change * gt.poses[i]);
+  RunData run;
+  run.sources["slot"] = est;
+  run.truth = gt;
+  const Metrics m = evaluate(run, EvalOptions());
+  const EgoMetrics& e = *m.ego.at("slot");
+  EXPECT_EQ(e.frames, 30);
+  EXPECT_NEAR(*e.ate_unaligned_rmse_m, 0.0, 1e-9);
+  EXPECT_NEAR(*e.ate_rmse_m, 0.0, 1e-9);
+  EXPECT_NEAR(*e.rpe1_t_m, 0.0, 1e-9);
+  EXPECT_EQ(m.primary_source, "slot");
+  EXPECT_FALSE(m.tracking);  // no labels
 }

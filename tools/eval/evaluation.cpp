@@ -60,7 +60,7 @@ Metrics evaluate(RunData run, const EvalOptions& options) {
       m.ego[name] = std::nullopt;
       continue;
     }
-    const auto [est, gt] = commonFrames(trajectory, *run.truth);
+    const auto [est, gt] = commonFrames(trajectory, inWorldOf(*run.truth, trajectory));
     if (est.empty())
       throw std::invalid_argument("the '" + name + "' trajectory (" + std::to_string(trajectory.size()) +
                                   " poses) and the ground truth share no frame");

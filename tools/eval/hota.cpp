@@ -62,7 +62,7 @@ std::optional<Hota> evaluateHota(const std::vector<TrackingFrame>& frames, const
   for (int k = 1; k <= 19; ++k) out.alphas.push_back(0.05 * k);
   const size_t A = out.alphas.size();
   std::vector<double> tp(A, 0), fn(A, 0), fp(A, 0), loc(A, 0);
-  std::vector<Eigen::MatrixXd> matches(A, Eigen::MatrixXd::Zero(G, T));
+  std::vector<std::map<std::pair<int, int>, double>> matches(A);  // per alpha: (label, track) -> matched frames
   for (size_t t = 0; t < frames.size(); ++t) {
     const Eigen::MatrixXd& s = sim[t];
     const int ng = static_cast<int>(s.rows()), nh = static_cast<int>(s.cols());
@@ -79,7 +79,7 @@ std::optional<Hota> evaluateHota(const std::vector<TrackingFrame>& frames, const
         if (col[i] < 0 || s(i, col[i]) < out.alphas[a] - kEps) continue;
         ++n;
         loc[a] += s(i, col[i]);
-        matches[a](gt_idx[t][i], tr_idx[t][col[i]]) += 1;
+        matches[a][{gt_idx[t][i], tr_idx[t][col[i]]}] += 1;
       }
       tp[a] += n;
       fn[a] += ng - n;
@@ -88,12 +88,8 @@ std::optional<Hota> evaluateHota(const std::vector<TrackingFrame>& frames, const
   }
 
   for (size_t a = 0; a < A; ++a) {
-    double assa = 0;
-    for (int g = 0; g < G; ++g)
-      for (int h = 0; h < T; ++h) {
-        const double m = matches[a](g, h);
-        if (m > 0) assa += m * m / (gt_count(g) + tr_count(h) - m);
-      }
+    double assa = 0;  // each of the m TPs of a pair has that pair's association IoU
+    for (const auto& [pair, m] : matches[a]) assa += m * m / (gt_count(pair.first) + tr_count(pair.second) - m);
     assa /= std::max(1.0, tp[a]);
     const double deta = tp[a] / std::max(1.0, tp[a] + fn[a] + fp[a]);
     const double h = std::sqrt(deta * assa);

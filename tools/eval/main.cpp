@@ -268,7 +268,12 @@ int run(int argc, char** argv) {
     fs::create_directories(out / "plots");
     std::vector<std::string> plots;
     if (!sources.empty()) {
-      plotTrajectories((out / "plots" / "trajectories.png").string(), sources, truth);
+      // The ground truth drawn in the primary source's world (they differ when the run started
+      // later in the sequence).
+      const Trajectory& primary = sources.at(primarySource(sources));
+      const std::optional<Trajectory> drawn_truth =
+          truth ? std::optional<Trajectory>(inWorldOf(*truth, primary)) : std::nullopt;
+      plotTrajectories((out / "plots" / "trajectories.png").string(), sources, drawn_truth);
       plots.push_back("plots/trajectories.png");
       if (truth) {
         plotErrorOverDistance((out / "plots" / "error_over_distance.png").string(), sources, *truth);

@@ -176,8 +176,8 @@ std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plo
     out << "No ego trajectory in the input.\n\n";
   } else {
     out << egoTable(m).render() << "\n"
-        << "ATE: RMSE of the position after SE(3) Umeyama alignment (unaligned: both start at the first scan's "
-           "lidar frame). RPE: RMSE over frame pairs 1 and 10 scans apart. t_rel / r_rel: KITTI devkit segments "
+        << "ATE: RMSE of the position after SE(3) Umeyama alignment (unaligned: in the world of the first "
+           "scan, the ground truth anchored at the run's first frame when the run started later). RPE: RMSE over frame pairs 1 and 10 scans apart. t_rel / r_rel: KITTI devkit segments "
            "of 100..800 m starting every 10 frames (and 10..80 m), poses in the lidar frame.\n\n";
   }
   out << "## Tracking (bird's-eye view, each scan's lidar frame)\n\n";

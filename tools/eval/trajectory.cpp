@@ -34,6 +34,18 @@ std::pair<Trajectory, Trajectory> commonFrames(const Trajectory& a, const Trajec
   return {ca, cb};
 }
 
+Trajectory inWorldOf(const Trajectory& gt, const Trajectory& est) {
+  if (est.empty() || gt.empty() || gt.frames[0] >= est.frames[0]) return gt;
+  for (size_t i = 0; i < gt.size(); ++i)
+    if (gt.frames[i] == est.frames[0]) {
+      const Pose change = est.poses[0] * gt.poses[i].inverse();
+      Trajectory out = gt;
+      for (Pose& T : out.poses) T = change * T;
+      return out;
+    }
+  throw std::invalid_argument("the ground truth has no pose for frame " + std::to_string(est.frames[0]));
+}
+
 TrajectoryFormat parseTrajectoryFormat(const std::string& name) {
   if (name == "kitti") return TrajectoryFormat::Kitti;
   if (name == "kitti_cam") return TrajectoryFormat::KittiCam;

@@ -23,6 +23,12 @@ struct Trajectory {
 // Restricts both trajectories to the frames they have in common.
 std::pair<Trajectory, Trajectory> commonFrames(const Trajectory& a, const Trajectory& b);
 
+// The ground truth in the estimate's world. A run that starts later in the sequence than the
+// ground truth has its world at its own first scan: then the ground truth is re-expressed so that
+// it coincides with `est` at est's first frame, G'_i = P_0 inv(G_0) G_i (relative errors are
+// unchanged). Otherwise `gt` is returned as it is.
+Trajectory inWorldOf(const Trajectory& gt, const Trajectory& est);
+
 // kitti: T_world_lidar as 3x4 rows. kitti_cam: camera-0 poses T_cam = Tr * T * inv(Tr) with
 // Tr = T_cam_velo (as KITTI's odometry ground truth). tum: "stamp tx ty tz qx qy qz qw".
 enum class TrajectoryFormat { Kitti, KittiCam, Tum };

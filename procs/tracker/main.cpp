@@ -2,7 +2,10 @@
 // Joins DETECTIONS and ODOMETRY of each scan by frame, puts the detections in the world frame
 // with the best ego pose known (SLOT_STATE, else chained odometry), associates them with the
 // trajectories of the window and publishes ASSOCIATIONS.
+// Offline (--kitti): the same association over a sequence's files, written as KITTI tracks.
 #include <chrono>
+#include <cstdio>
+#include <iostream>
 #include <string>
 
 #include "dlslot/associations_t.hpp"
@@ -13,6 +16,7 @@
 #include "dlslot/slot_state_t.hpp"
 #include "ego_pose_chain.hpp"
 #include "frame_joiner.hpp"
+#include "offline_run.hpp"
 #include "trajectory_associator.hpp"
 
 using namespace dlslot;
@@ -44,6 +48,12 @@ struct TrackerConfig {
     }
   }
 };
+
+std::string seconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g s", s);
+  return buf;
+}
 
 double secondsNow() {
   return std::chrono::duration<double>(Node::Clock::now().time_since_epoch()).count();
@@ -92,12 +102,49 @@ associations_t toMsg(const JoinedFrame& joined, const EgoPose& ego, const FrameA
   return m;
 }
 
+struct OfflineOptions {
+  std::string kitti_root, sequence, poses, tracks_out;
+  std::vector<std::string> detections;
+  double min_detection_score = -1e9, frame_period_s = 0.1;
+  bool initialized_only = false;
+};
+
+// Associates a whole sequence from files and writes the tracks (no LCM).
+int runOffline(const OfflineOptions& o, const AssociatorConfig& config) {
+  if (o.sequence.empty()) throw std::invalid_argument("--sequence SSSS is required with --kitti");
+  if (o.tracks_out.empty()) throw std::invalid_argument("--tracks-out FILE is required with --kitti");
+  const kitti::SequenceReader reader(o.kitti_root, o.sequence, o.detections, o.min_detection_score, o.frame_period_s);
+  std::vector<Pose> poses;
+  if (!o.poses.empty()) {
+    poses = kitti::readPoses(o.poses);
+  } else if (reader.hasGroundTruthPoses()) {
+    poses = reader.groundTruthPoses();
+  } else {
+    throw std::invalid_argument("no ego poses: the sequence has none; give --poses FILE (KITTI 3x4 lidar poses)");
+  }
+  const OfflineResult r = associateSequence(reader, poses, config, o.initialized_only);
+  kitti::writeTrackingLabels(o.tracks_out, r.tracks);
+  std::printf("%d frames, %d detections (%d initialized), %d trajectories; association %.3f ms mean, %.3f ms p95 a frame\n",
+              reader.size(), r.detections, r.initialized, r.trajectories, r.association_ms.mean(),
+              r.association_ms.percentile(95));
+  return 0;
+}
+
 int run(int argc, char** argv) {
   NodeOptions node_opts;
+  OfflineOptions off;
   CommandLine cl("dlslot-tracker",
                  "Associates each scan's detections with the trajectories of a sliding window (DL-SLOT III-B).\n"
-                 "Subscribes DETECTIONS, ODOMETRY, SLOT_STATE; publishes ASSOCIATIONS and PROCESS_STATUS.");
+                 "Subscribes DETECTIONS, ODOMETRY, SLOT_STATE; publishes ASSOCIATIONS and PROCESS_STATUS.\n"
+                 "With --kitti: offline over a sequence's files, writing KITTI tracking results (for dlslot-eval --tracks).");
   node_opts.addTo(cl);
+  cl.option("--kitti", &off.kitti_root, "offline: KITTI root (tracking or odometry layout)");
+  cl.option("--sequence", &off.sequence, "offline: sequence name, e.g. 0000");
+  cl.repeated("--detections", &off.detections, "offline: detection file or directory");
+  cl.option("--poses", &off.poses, "offline: ego poses, KITTI 3x4 lidar poses (default: the sequence's ground truth)");
+  cl.option("--tracks-out", &off.tracks_out, "offline: output file, KITTI tracking result format");
+  cl.option("--min-score", &off.min_detection_score, "offline: drop detections scoring below this (default -1e9)");
+  cl.flag("--initialized-only", &off.initialized_only, "offline: output only initialized associations (III-D)");
   if (!cl.parse(argc, argv)) return 0;
 
   ConfigSection root_cfg = loadConfig(node_opts.config);
@@ -106,6 +153,7 @@ int run(int argc, char** argv) {
   TrackerConfig cfg;
   cfg.read(root_cfg.section("tracker"));
   if (node_opts.check_config) return 0;
+  if (!off.kitti_root.empty()) return runOffline(off, cfg.associator);
 
   Node node("tracker", node_opts.lcm_url, channels);
   ProcessStatus& status = node.status();
@@ -118,12 +166,12 @@ int run(int argc, char** argv) {
     const std::string frame = std::to_string(joined.frame);
     if (!joined.has_odometry) {
       status.timeout(channels.odometry + " for frame " + frame + " not within " +
-                     std::to_string(cfg.join_timeout_s) + " s; ego motion predicted");
+                     seconds(cfg.join_timeout_s) + "; ego motion predicted");
       status.count("odometry_missing");
     }
     if (!joined.detections) {
       status.timeout(channels.detections + " for frame " + frame + " not within " +
-                     std::to_string(cfg.join_timeout_s) + " s; frame handled as empty");
+                     seconds(cfg.join_timeout_s) + "; frame handled as empty");
       status.count("detections_missing");
     }
     const EgoPose ego = ego_poses.poseAt(joined.frame);

@@ -1,0 +1,347 @@
+// Every backend factor: its residual at a known configuration and its Jacobian against
+// numeric differentiation in the PoseManifold's tangent space; the manifold itself; the
+// marginalization prior; and the Marginalizer's linearization against Ceres' own.
+#include <ceres/ceres.h>
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <random>
+
+#include "backend/backend_config.hpp"
+#include "backend/constant_velocity_factor.hpp"
+#include "backend/landmark_observation_factor.hpp"
+#include "backend/marginalization_prior.hpp"
+#include "backend/marginalizer.hpp"
+#include "backend/observation_factor.hpp"
+#include "backend/odometry_factor.hpp"
+#include "backend/pose_change_factor.hpp"
+#include "backend/pose_manifold.hpp"
+#include "backend_scene.hpp"
+
+using namespace dlslot;
+using namespace dlslot::backend;
+using dlslot::backend::test::planarPose;
+
+namespace {
+
+Pose randomPose(std::mt19937& rng, double t_scale = 5.0, double r_scale = 1.0) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Vector6 d;
+  for (int i = 0; i < 3; ++i) d[i] = t_scale * n(rng);
+  for (int i = 3; i < 6; ++i) d[i] = r_scale * n(rng);
+  return plus(Pose::Identity(), d);
+}
+
+Matrix6 randomSqrtInfo(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.5, 3.0), o(-0.3, 0.3);
+  Matrix6 S = Matrix6::Zero();
+  for (int r = 0; r < 6; ++r)
+    for (int c = r; c < 6; ++c) S(r, c) = r == c ? u(rng) : o(rng);
+  return S;
+}
+
+// Residual of `cost` at the given blocks.
+Eigen::VectorXd residual(const ceres::CostFunction& cost, const std::vector<Vector7>& blocks) {
+  std::vector<const double*> p;
+  for (const auto& b : blocks) p.push_back(b.data());
+  Eigen::VectorXd r(cost.num_residuals());
+  EXPECT_TRUE(cost.Evaluate(p.data(), r.data(), nullptr));
+  return r;
+}
+
+// Checks d residual / d tangent (analytic ambient Jacobian x PlusJacobian) against central
+// differences through the manifold's Plus.
+void expectJacobiansMatchNumeric(const ceres::CostFunction& cost, const std::vector<Vector7>& blocks,
+                                 double tol = 1e-6) {
+  const int m = cost.num_residuals();
+  const int n = static_cast<int>(blocks.size());
+  std::vector<const double*> p;
+  for (const auto& b : blocks) p.push_back(b.data());
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>> J(n);
+  std::vector<double*> jp(n);
+  for (int k = 0; k < n; ++k) {
+    J[k].resize(m, 7);
+    jp[k] = J[k].data();
+  }
+  Eigen::VectorXd r(m);
+  ASSERT_TRUE(cost.Evaluate(p.data(), r.data(), jp.data()));
+  PoseManifold manifold;
+  const double h = 1e-6;
+  for (int k = 0; k < n; ++k) {
+    const Eigen::MatrixXd analytic = J[k] * PoseManifold::plusJacobian(blocks[k].data());
+    Eigen::MatrixXd numeric(m, 6);
+    for (int j = 0; j < 6; ++j) {
+      Vector6 d = Vector6::Zero();
+      d[j] = h;
+      std::vector<Vector7> plus_b = blocks, minus_b = blocks;
+      manifold.Plus(blocks[k].data(), d.data(), plus_b[k].data());
+      d[j] = -h;
+      manifold.Plus(blocks[k].data(), d.data(), minus_b[k].data());
+      numeric.col(j) = (residual(cost, plus_b) - residual(cost, minus_b)) / (2 * h);
+    }
+    EXPECT_LT((analytic - numeric).norm(), tol * std::max(1.0, numeric.norm()))
+        << "block " << k << "\nanalytic\n" << analytic << "\nnumeric\n" << numeric;
+  }
+}
+
+Pose error(std::mt19937& rng) { return randomPose(rng, 0.3, 0.2); }
+
+}  // namespace
+
+TEST(BackendSe3, ExpLogRoundTripAndSmallAngles) {
+  std::mt19937 rng(3);
+  for (int i = 0; i < 50; ++i) {
+    const Pose T = randomPose(rng, 1.0, 0.9);
+    const Eigen::Vector3d phi = logSO3(Eigen::Quaterniond(T.linear()));
+    EXPECT_TRUE(expSO3(phi).toRotationMatrix().isApprox(T.linear(), 1e-12));
+  }
+  const Eigen::Vector3d tiny(1e-12, -2e-12, 3e-12);
+  EXPECT_TRUE(logSO3(expSO3(tiny)).isApprox(tiny, 1e-9));
+  EXPECT_NEAR(logSO3(expSO3(Eigen::Vector3d(0, 0, 3.0))).z(), 3.0, 1e-12);
+}
+
+TEST(BackendPoseManifold, Invariants) {
+  std::mt19937 rng(4);
+  PoseManifold m;
+  for (int i = 0; i < 20; ++i) {
+    const Vector7 x = toBlock(randomPose(rng));
+    Vector6 d;
+    for (int j = 0; j < 6; ++j) d[j] = std::normal_distribution<double>(0, 0.4)(rng);
+    Vector7 y, x0;
+    const Vector6 zero = Vector6::Zero();
+    m.Plus(x.data(), zero.data(), x0.data());
+    EXPECT_TRUE(x0.isApprox(x, 1e-14));
+    m.Plus(x.data(), d.data(), y.data());
+    Vector6 back;
+    m.Minus(y.data(), x.data(), back.data());
+    EXPECT_TRUE(back.isApprox(d, 1e-10)) << back.transpose() << " vs " << d.transpose();
+    // MinusJacobian is a left inverse of PlusJacobian.
+    const Matrix6 I = PoseManifold::minusJacobian(x.data()) * PoseManifold::plusJacobian(x.data());
+    EXPECT_TRUE(I.isApprox(Matrix6::Identity(), 1e-12));
+    // PlusJacobian against central differences of Plus.
+    Eigen::Matrix<double, 7, 6> numeric;
+    for (int j = 0; j < 6; ++j) {
+      Vector6 h = Vector6::Zero();
+      h[j] = 1e-6;
+      Vector7 a, b;
+      m.Plus(x.data(), h.data(), a.data());
+      h[j] = -1e-6;
+      m.Plus(x.data(), h.data(), b.data());
+      numeric.col(j) = (a - b) / 2e-6;
+    }
+    EXPECT_LT((numeric - Eigen::Matrix<double, 7, 6>(PoseManifold::plusJacobian(x.data()))).norm(), 1e-8);
+    // MinusJacobian against central differences of Minus(., x) at x in ambient coordinates.
+    Eigen::Matrix<double, 6, 7> numeric_minus;
+    for (int j = 0; j < 7; ++j) {
+      Vector7 a = x, b = x;
+      a[j] += 1e-7;
+      b[j] -= 1e-7;
+      Vector6 da, db;
+      m.Minus(a.data(), x.data(), da.data());
+      m.Minus(b.data(), x.data(), db.data());
+      numeric_minus.col(j) = (da - db) / 2e-7;
+    }
+    EXPECT_LT((numeric_minus - Eigen::Matrix<double, 6, 7>(PoseManifold::minusJacobian(x.data()))).norm(), 1e-6);
+  }
+}
+
+TEST(BackendFactors, OdometryResidualAndJacobians) {
+  std::mt19937 rng(5);
+  for (int i = 0; i < 10; ++i) {
+    const Pose Xp = randomPose(rng), Xc = randomPose(rng), E = error(rng);
+    const Matrix6 S = randomSqrtInfo(rng);
+    // T = (Xp^-1 Xc) E makes eq. 8's error exactly E.
+    OdometryFactor f(Xp.inverse() * Xc * E, S);
+    const std::vector<Vector7> blocks{toBlock(Xp), toBlock(Xc)};
+    EXPECT_TRUE(residual(f, blocks).isApprox(S * logPose(E), 1e-9));
+    expectJacobiansMatchNumeric(f, blocks);
+  }
+  OdometryFactor consistent(Pose::Identity(), Matrix6::Identity());
+  const Pose X = planarPose(3, 4, 0.5);
+  EXPECT_LT(residual(consistent, {toBlock(X), toBlock(X)}).norm(), 1e-12);
+}
+
+TEST(BackendFactors, ObservationAndLandmarkResidualAndJacobians) {
+  std::mt19937 rng(6);
+  for (int i = 0; i < 10; ++i) {
+    const Pose X = randomPose(rng), o = randomPose(rng), E = error(rng);
+    const Matrix6 S = randomSqrtInfo(rng);
+    // b = X^-1 o E: eq. 9's error (X^-1 o)^-1 b is E.
+    const Pose b = X.inverse() * o * E;
+    ObservationFactor obs(b, S);
+    LandmarkObservationFactor landmark(b, S);
+    const std::vector<Vector7> blocks{toBlock(X), toBlock(o)};
+    EXPECT_TRUE(residual(obs, blocks).isApprox(S * logPose(E), 1e-9));
+    EXPECT_TRUE(residual(landmark, blocks).isApprox(S * logPose(E), 1e-9));
+    expectJacobiansMatchNumeric(obs, blocks);
+    expectJacobiansMatchNumeric(landmark, blocks);
+  }
+  // A box 10 m ahead, seen from the origin, of an object 10 m ahead: no error.
+  ObservationFactor ahead(planarPose(10, 0, 0), Matrix6::Identity());
+  EXPECT_LT(residual(ahead, {toBlock(Pose::Identity()), toBlock(planarPose(10, 0, 0))}).norm(), 1e-12);
+  // The object 0.5 m to the left of where the box says: t_e = (0, -0.5, 0) in the object frame.
+  const Eigen::VectorXd r = residual(ahead, {toBlock(Pose::Identity()), toBlock(planarPose(10, 0.5, 0))});
+  EXPECT_NEAR(r[1], -0.5, 1e-12);
+  EXPECT_NEAR(r.norm(), 0.5, 1e-12);
+}
+
+TEST(BackendFactors, PoseChangeResidualAndJacobians) {
+  std::mt19937 rng(7);
+  for (int i = 0; i < 10; ++i) {
+    const Pose o1 = randomPose(rng), o2 = randomPose(rng), E = error(rng);
+    const Matrix6 S = randomSqrtInfo(rng);
+    // c = (o1^-1 o2) E: the corrected eq. 10, (o1^-1 o2)^-1 c, is E.
+    const Pose c = o1.inverse() * o2 * E;
+    PoseChangeFactor f(S);
+    const std::vector<Vector7> blocks{toBlock(o1), toBlock(o2), toBlock(c)};
+    EXPECT_TRUE(residual(f, blocks).isApprox(S * logPose(E), 1e-9));
+    expectJacobiansMatchNumeric(f, blocks);
+  }
+  // eq. 2 holds exactly: no error.
+  const Pose o1 = planarPose(1, 2, 0.3), o2 = planarPose(2, 2.5, 0.35);
+  PoseChangeFactor f(Matrix6::Identity());
+  EXPECT_LT(residual(f, {toBlock(o1), toBlock(o2), toBlock(o1.inverse() * o2)}).norm(), 1e-12);
+}
+
+TEST(BackendFactors, ConstantVelocityResidualAndJacobians) {
+  std::mt19937 rng(8);
+  for (int i = 0; i < 10; ++i) {
+    const Pose c1 = randomPose(rng, 1.0, 0.3), E = error(rng);
+    const Matrix6 S = randomSqrtInfo(rng);
+    ConstantVelocityFactor f(S);
+    const std::vector<Vector7> blocks{toBlock(c1), toBlock(c1 * E)};
+    EXPECT_TRUE(residual(f, blocks).isApprox(S * logPose(E), 1e-9));
+    expectJacobiansMatchNumeric(f, blocks);
+  }
+  // 1 m per frame, then 1.2 m per frame straight ahead: 0.2 m error along x.
+  ConstantVelocityFactor f(Matrix6::Identity());
+  const Eigen::VectorXd r = residual(f, {toBlock(planarPose(1, 0, 0)), toBlock(planarPose(1.2, 0, 0))});
+  EXPECT_NEAR(r[0], 0.2, 1e-12);
+  EXPECT_NEAR(r.norm(), 0.2, 1e-12);
+}
+
+TEST(BackendFactors, MarginalizationPriorResidualJacobianAndLinearization) {
+  std::mt19937 rng(9);
+  std::vector<Vector7> x_lin, x;
+  for (int i = 0; i < 3; ++i) {
+    const Pose p = randomPose(rng);
+    x_lin.push_back(toBlock(p));
+    x.push_back(toBlock(p * error(rng)));
+  }
+  const Eigen::MatrixXd J = Eigen::MatrixXd::Random(18, 18);
+  const Eigen::VectorXd r0 = Eigen::VectorXd::Random(18);
+  MarginalizationPrior prior(x_lin, J, r0);
+  EXPECT_TRUE(residual(prior, x_lin).isApprox(r0, 1e-12));
+  Eigen::VectorXd dx(18);
+  for (int i = 0; i < 3; ++i) dx.segment<6>(6 * i) = minus(fromBlock(x[i].data()), fromBlock(x_lin[i].data()));
+  EXPECT_TRUE(residual(prior, x).isApprox(r0 + J * dx, 1e-12));
+  expectJacobiansMatchNumeric(prior, x, 1e-6);
+
+  // linearize() gives Jx^T Jx and Jx^T r of the tangent Jacobian at x.
+  std::vector<const double*> p;
+  for (const auto& b : x) p.push_back(b.data());
+  Eigen::MatrixXd H;
+  Eigen::VectorXd g;
+  prior.linearize(p.data(), H, g);
+  Eigen::MatrixXd Jx(18, 18);
+  for (int i = 0; i < 3; ++i) Jx.middleCols<6>(6 * i) = J.middleCols<6>(6 * i) * minusJacobianAt(fromBlock(x[i].data()), fromBlock(x_lin[i].data()));
+  EXPECT_TRUE(H.isApprox(Jx.transpose() * Jx, 1e-10));
+  EXPECT_TRUE(g.isApprox(Jx.transpose() * residual(prior, x), 1e-10));
+}
+
+// With nothing leaving, the Marginalizer's prior is the Gauss-Newton model of its factors:
+// J*^T J* and J*^T r* must equal what Ceres itself computes (tangent Jacobian, robust loss).
+TEST(BackendMarginalizer, LinearizationMatchesCeres) {
+  std::mt19937 rng(10);
+  std::vector<Vector7> blocks;
+  for (int i = 0; i < 4; ++i) blocks.push_back(toBlock(randomPose(rng)));
+  std::vector<Factor> factors;
+  auto loss = std::make_shared<ceres::CauchyLoss>(1.0);
+  factors.push_back({std::shared_ptr<ceres::CostFunction>(OdometryFactor::Create(error(rng), randomSqrtInfo(rng))), nullptr,
+                     {blocks[0].data(), blocks[1].data()}});
+  factors.push_back({std::shared_ptr<ceres::CostFunction>(ObservationFactor::Create(error(rng), randomSqrtInfo(rng))), loss,
+                     {blocks[1].data(), blocks[2].data()}});
+  factors.push_back({std::shared_ptr<ceres::CostFunction>(PoseChangeFactor::Create(randomSqrtInfo(rng))), nullptr,
+                     {blocks[0].data(), blocks[2].data(), blocks[3].data()}});
+  Marginalizer marginalizer;
+  std::vector<const Factor*> all;
+  for (const Factor& f : factors) all.push_back(&f);
+  const std::optional<Factor> prior = marginalizer.marginalize(all, {}, {});
+  ASSERT_TRUE(prior.has_value());
+
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(po);
+  PoseManifold manifold;
+  std::vector<double*> order = prior->blocks;
+  for (double* b : order) problem.AddParameterBlock(b, 7, &manifold);
+  for (const Factor& f : factors) problem.AddResidualBlock(f.cost.get(), f.loss.get(), f.blocks);
+  ceres::Problem::EvaluateOptions eo;
+  eo.parameter_blocks = order;
+  std::vector<double> r;
+  ceres::CRSMatrix crs;
+  double cost = 0;
+  problem.Evaluate(eo, &cost, &r, nullptr, &crs);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row)
+    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) J(row, crs.cols[k]) = crs.values[k];
+  const Eigen::VectorXd rv = Eigen::Map<Eigen::VectorXd>(r.data(), r.size());
+
+  const auto* mp = dynamic_cast<const MarginalizationPrior*>(prior->cost.get());
+  ASSERT_NE(mp, nullptr);
+  Eigen::MatrixXd H;
+  Eigen::VectorXd g;
+  mp->linearize(prior->blocks.data(), H, g);
+  EXPECT_TRUE(H.isApprox(J.transpose() * J, 1e-9)) << H - J.transpose() * J;
+  EXPECT_TRUE(g.isApprox(J.transpose() * rv, 1e-9));
+}
+
+// Marginalizing a block is the Schur complement of the linearized system.
+TEST(BackendMarginalizer, SchurComplementOfTheLinearizedSystem) {
+  std::mt19937 rng(11);
+  std::vector<Vector7> blocks;
+  for (int i = 0; i < 3; ++i) blocks.push_back(toBlock(randomPose(rng)));
+  std::vector<Factor> factors;
+  factors.push_back({std::shared_ptr<ceres::CostFunction>(MarginalizationPrior::CreatePosePrior(
+                         plus(fromBlock(blocks[0].data()), Vector6::Constant(0.01)), randomSqrtInfo(rng))),
+                     nullptr, {blocks[0].data()}});
+  factors.push_back({std::shared_ptr<ceres::CostFunction>(OdometryFactor::Create(error(rng), randomSqrtInfo(rng))), nullptr,
+                     {blocks[0].data(), blocks[1].data()}});
+  factors.push_back({std::shared_ptr<ceres::CostFunction>(OdometryFactor::Create(error(rng), randomSqrtInfo(rng))), nullptr,
+                     {blocks[0].data(), blocks[2].data()}});
+  std::vector<const Factor*> all;
+  for (const Factor& f : factors) all.push_back(&f);
+  Marginalizer marginalizer;
+  const auto full = marginalizer.marginalize(all, {}, {});
+  const auto reduced = marginalizer.marginalize(all, {blocks[0].data()}, {});
+  ASSERT_TRUE(full && reduced);
+  EXPECT_EQ(marginalizer.lastStats().leaving_dim, 6);
+  EXPECT_EQ(marginalizer.lastStats().kept_dim, 12);
+  Eigen::MatrixXd H, Hr;
+  Eigen::VectorXd g, gr;
+  dynamic_cast<const MarginalizationPrior&>(*full->cost).linearize(full->blocks.data(), H, g);
+  dynamic_cast<const MarginalizationPrior&>(*reduced->cost).linearize(reduced->blocks.data(), Hr, gr);
+  // full->blocks is {b0, b1, b2}; reduced->blocks is {b1, b2}.
+  ASSERT_EQ(full->blocks[0], blocks[0].data());
+  const Eigen::MatrixXd Hmm = H.topLeftCorner(6, 6), Hmr = H.topRightCorner(6, 12);
+  const Eigen::MatrixXd expected_H = H.bottomRightCorner(12, 12) - Hmr.transpose() * Hmm.inverse() * Hmr;
+  const Eigen::VectorXd expected_g = g.tail(12) - Hmr.transpose() * Hmm.inverse() * g.head(6);
+  EXPECT_TRUE(Hr.isApprox(expected_H, 1e-8));
+  EXPECT_TRUE(gr.isApprox(expected_g, 1e-8));
+}
+
+TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
+  ConfigSection root = loadConfig(std::string(DLSLOT_SOURCE_DIR) + "/config/dlslot.yaml");
+  ConfigSection section = root.section("backend");
+  const BackendConfig c = BackendConfig::read(section);
+  section.skip("join_timeout_s");
+  EXPECT_NO_THROW(section.finish());
+  EXPECT_EQ(c.mode, Mode::kSlot);
+  EXPECT_EQ(c.window_size, 10);
+  const Matrix6 S = sqrtInformation(c.odometry_sigma);
+  EXPECT_NEAR(S(0, 0), 1.0 / c.odometry_sigma[0], 1e-12);
+  EXPECT_EQ(parseMode("two-stage"), Mode::kTwoStage);
+  EXPECT_THROW(parseMode("joint"), std::invalid_argument);
+}

@@ -23,7 +23,7 @@ struct AssociatorConfig {
   // theta of eq. 6, on the squared bird's-eye distance (eq. 7). A young trajectory predicts with
   // its last position, so theta must exceed what a car moves in a frame (3 m at 30 m/s and 10 Hz).
   double gate_sq_m2 = 16.0;
-  int max_missed_frames = 5;          // a trajectory unseen for more frames than this ends
+  int max_missed_frames = 9;          // a trajectory unseen for more frames than this ends (< k)
   Predictor predictor = Predictor::Polynomial;
   int max_polynomial_degree = 3;      // eq. 3 is a cubic
   double max_noise_gain = 3.0;        // lower the degree while the fit extrapolates noise more (predictPolynomial)

@@ -125,7 +125,6 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
       // An unmatched detection starts a trajectory (III-B).
       Trajectory tr;
       tr.id = next_id_++;
-      tr.first_frame = frame;
       trajectories_.push_back(std::move(tr));
       u = static_cast<int>(trajectories_.size()) - 1;
       a.new_track = true;

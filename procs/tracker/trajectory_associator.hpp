@@ -37,7 +37,6 @@ struct Trajectory {
   int id = -1;
   Box last_box;  // world frame; type is the class the trajectory is gated with
   int last_frame = -1;
-  int first_frame = -1;
   std::vector<TrajectoryPoint> window;
   double displacement = 0.0;
   bool is_dynamic = false;
@@ -47,7 +46,7 @@ struct Trajectory {
 struct Association {
   int detection_index = -1;   // index into the detections given to associate()
   int track_id = -1;
-  bool initialized = false;   // matched a trajectory with >= g observations (its prediction was polynomial)
+  bool initialized = false;   // matched a trajectory with >= g observations (predicted by its fit, III-D)
   bool new_track = false;     // the detection started a trajectory
   int num_observations = 0;   // in the window, this one included
   Box box_lidar;              // b_t

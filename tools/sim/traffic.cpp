@@ -44,7 +44,7 @@ struct Following {
 Following followingOf(const std::string& type) {
   if (type == "Pedestrian") return {0.8, 1.0, 0.6, 0.6};
   if (type == "Cyclist") return {1.0, 1.5, 1.0, 0.8};
-  return {1.5, 2.0, 2.0, 1.2};
+  return {1.5, 2.0, 2.0, 0.9};
 }
 
 struct Mover {
@@ -286,18 +286,26 @@ Motion simulateMotion(const Scenario& sc, const World& world) {
       m.v0 = start_time > 0 ? 0.0 : cruise;
       m.profile = agentProfile(spec, cruise, start_time, duration, ag.type, rng);
       m.stops = stopsOn(*m.path, sc);
-      // A free place on the lane at the start: keep the following distance to everyone there.
+      // A place on the lane at the start: its share of the interval (so `count` agents spread
+      // over it), moved forward or back where needed to keep the following distance to everyone.
       const double lo = spec.start_s_m.hi > spec.start_s_m.lo ? spec.start_s_m.lo : 0.0;
       const double hi = spec.start_s_m.hi > spec.start_s_m.lo ? spec.start_s_m.hi : m.path->length();
-      bool placed = false;
-      for (int attempt = 0; attempt < 30 && !placed; ++attempt) {
-        m.s0 = rng.uniform(lo, hi);
-        placed = true;
+      const double slot = (hi - lo) / spec.count;
+      const double want = lo + slot * (i + rng.uniform(0.3, 0.7));
+      auto free = [&](double s) {
         for (const Mover& o : movers)
           if (o.lane == m.lane &&
-              std::abs(o.s0 - m.s0) < o.half_length + m.half_length + m.follow.s0 + m.follow.T * std::max(m.v0, o.v0))
-            placed = false;
-      }
+              std::abs(o.s0 - s) < o.half_length + m.half_length + m.follow.s0 + m.follow.T * std::max(m.v0, o.v0))
+            return false;
+        return true;
+      };
+      bool placed = false;
+      for (double shift = 0; shift <= 0.5 * slot && !placed; shift += 1.0)
+        for (double s : {want + shift, want - shift})
+          if (!placed && s >= lo && s <= hi && free(s)) {
+            m.s0 = s;
+            placed = true;
+          }
       if (!placed) continue;
       movers.push_back(m);
       agents.push_back(ag);

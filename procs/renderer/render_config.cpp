@@ -96,8 +96,8 @@ RendererConfig readRendererConfig(ConfigSection root) {
   checkPositive(c.frame_timeout_s, s, "frame_timeout_s");
   s.get("trail_frames", c.trail_frames);
   s.get("png_compression", c.png_compression);
-  if (c.png_compression < 0 || c.png_compression > 9)
-    throw ConfigError(s.file() + ": " + s.path() + ".png_compression: expected an integer 0-9");
+  if (c.png_compression < -1 || c.png_compression > 9)
+    throw ConfigError(s.file() + ": " + s.path() + ".png_compression: expected -1 (fastest) or a zlib level 0-9");
   s.finish();
   return c;
 }

@@ -222,9 +222,8 @@ int runPipeline(int argc, char** argv) {
 
   // 6. Evaluate and export.
   if (!no_eval) {
-    std::vector<std::string> eval = args(bin + "/dlslot-eval", {"--log", out + "/run.lcmlog", "--kitti", root,
-                                                                "--sequence", sequence, "--out", out, "--export", out});
-    eval.erase(std::remove(eval.begin(), eval.end(), std::string("--lcm-url")), eval.end());
+    const std::vector<std::string> eval = {bin + "/dlslot-eval", "--config", config, "--log", out + "/run.lcmlog",
+                                           "--kitti", root, "--sequence", sequence, "--out", out, "--export", out};
     if (runToEnd(sup, "eval", eval, logs + "/eval.log") != 0) throw Failure("dlslot-eval failed:\n" + sup.tail("eval", 30));
     std::cout << run::readText(logs + "/eval.log");
   }

@@ -121,13 +121,14 @@ void drawTracks(cv::Mat& img, const RenderInput& in, const ViewTransform& view, 
     line(img, centre(p), front(p), c, 1);
   }
   // Labels last, above every box.
+  LabelPlacer labels;
   for (const TrackState& t : in.tracks) {
     const Polygon p = project(footprint(t.pose, t.size), view.worldToPixel());
     Eigen::Vector2d top = p[0];
     for (const auto& q : p)
       if (q.y() < top.y() || (q.y() == top.y() && q.x() > top.x())) top = q;
     const std::string s = t.is_dynamic ? strf("%d  %.1f m/s", t.id, t.velocity.head<2>().norm()) : strf("%d", t.id);
-    label(img, s, cv::Point(static_cast<int>(top.x()) + 4, static_cast<int>(top.y()) - 4), trackColour(t.id));
+    labels.place(img, s, cv::Point(static_cast<int>(top.x()) + 4, static_cast<int>(top.y()) - 4), trackColour(t.id));
   }
 }
 
@@ -136,10 +137,10 @@ void drawEgo(cv::Mat& img, const ViewTransform& view) {
   Pose T = Pose::Identity();
   T.translation() = Eigen::Vector3d(-0.3, 0, 0);
   const Polygon p = project(footprint(T, Eigen::Vector3d(4.4, 1.8, 0)), view.lidarToPixel());
-  fillTranslucent(img, p, colour::kSlot, 0.45);
-  polyline(img, p, true, colour::kSlot, 2);
+  fillTranslucent(img, p, colour::kEgo, 0.3);
+  polyline(img, p, true, colour::kEgo, 2);
   const Eigen::Vector2d f = front(p), c = centre(p);
-  arrow(img, c, f + (f - c) * 0.6, colour::kSlot, 2);
+  arrow(img, c, f + (f - c) * 0.6, colour::kEgo, 2);
 }
 
 double moduleTotal(const ModuleTiming& m) {
@@ -190,7 +191,8 @@ std::vector<TextLine> statusLines(const RenderInput& in, const PointCounts& pts)
 std::vector<TextLine> timingLines(const RenderInput& in) {
   std::vector<TextLine> lines;
   for (const ModuleTiming& m : in.timings) {
-    lines.push_back({strf("%-9s %7.1f ms", m.module.c_str(), moduleTotal(m)), colour::kText, kNormalFont});
+    const double total = moduleTotal(m);
+    lines.push_back({strf(total < 10 ? "%-9s %7.2f ms" : "%-9s %7.1f ms", m.module.c_str(), total), colour::kText, kNormalFont});
     std::string detail;
     for (const auto& [name, ms] : m.stages) {
       if (name == "total") continue;

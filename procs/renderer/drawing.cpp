@@ -100,10 +100,24 @@ cv::Size textSize(const std::string& s, double scale, int thickness) {
   return cv::getTextSize(s, cv::FONT_HERSHEY_SIMPLEX, scale, thickness, &baseline);
 }
 
-void label(cv::Mat& img, const std::string& s, cv::Point origin, const cv::Scalar& colour, double scale) {
+cv::Rect label(cv::Mat& img, const std::string& s, cv::Point origin, const cv::Scalar& colour, double scale) {
   const cv::Size sz = textSize(s, scale);
-  shade(img, cv::Rect(origin.x - 2, origin.y - sz.height - 3, sz.width + 4, sz.height + 6), 0.6);
+  const cv::Rect backdrop(origin.x - 2, origin.y - sz.height - 3, sz.width + 4, sz.height + 6);
+  shade(img, backdrop, 0.6);
   text(img, s, origin, colour, scale);
+  return backdrop;
+}
+
+void LabelPlacer::place(cv::Mat& img, const std::string& s, cv::Point origin, const cv::Scalar& colour) {
+  const cv::Size sz = textSize(s);
+  auto backdrop = [&](cv::Point o) { return cv::Rect(o.x - 2, o.y - sz.height - 3, sz.width + 4, sz.height + 6); };
+  for (int tries = 0; tries < 6; ++tries) {
+    bool free = true;
+    for (const cv::Rect& r : placed_) free = free && (r & backdrop(origin)).area() == 0;
+    if (free) break;
+    origin.y += sz.height + 7;
+  }
+  placed_.push_back(label(img, s, origin, colour));
 }
 
 cv::Rect textPanel(cv::Mat& img, const std::vector<TextLine>& lines, cv::Point corner, bool right_aligned) {

@@ -44,8 +44,18 @@ constexpr double kSmallFont = 0.42, kNormalFont = 0.5, kTitleFont = 0.62;
 void text(cv::Mat& img, const std::string& s, cv::Point origin, const cv::Scalar& colour, double scale = kSmallFont,
           int thickness = 1);
 cv::Size textSize(const std::string& s, double scale = kSmallFont, int thickness = 1);
-// A short label on a dark backdrop, left end of its baseline at `origin`.
-void label(cv::Mat& img, const std::string& s, cv::Point origin, const cv::Scalar& colour, double scale = kSmallFont);
+// A short label on a dark backdrop, left end of its baseline at `origin`; returns its backdrop.
+cv::Rect label(cv::Mat& img, const std::string& s, cv::Point origin, const cv::Scalar& colour,
+               double scale = kSmallFont);
+// Labels that step down past the ones already placed instead of covering them (greedy, in call
+// order, so the result is deterministic).
+class LabelPlacer {
+ public:
+  void place(cv::Mat& img, const std::string& s, cv::Point origin, const cv::Scalar& colour);
+
+ private:
+  std::vector<cv::Rect> placed_;
+};
 
 // Lines of text on a shaded panel whose top-left (top-right when right_aligned) corner is
 // `corner`; returns the panel's rectangle.

@@ -74,6 +74,7 @@ int renderLog(const std::string& log_path, const std::string& out, const Rendere
   }
   sink.draw(state.takeAll());
   const std::string summary = writer.writeSummary(state.summary());
+  progress.update(sink.written());
   progress.finish();
   report(sink, out, summary, status);
   return 0;

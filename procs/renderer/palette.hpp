@@ -18,7 +18,8 @@ inline const cv::Scalar kWarning(70, 150, 255);
 inline const cv::Scalar kDetection(60, 230, 255);     // yellow
 inline const cv::Scalar kGroundTruth(120, 230, 120);  // green, as its trajectory
 inline const cv::Scalar kOdometry(230, 90, 230);      // magenta
-inline const cv::Scalar kSlot(255, 215, 0);           // cyan: DL-SLOT and the ego vehicle
+inline const cv::Scalar kSlot(255, 215, 0);           // cyan: DL-SLOT
+inline const cv::Scalar kEgo(235, 235, 235);          // the ego vehicle, whatever estimates its pose
 inline const cv::Scalar kPanel(16, 14, 12);
 }  // namespace colour
 

@@ -57,7 +57,7 @@ void drawMap(cv::Mat& img, const DensityMap& map, const ViewTransform& view) {
   auto nth = occupied.begin() + static_cast<long>(0.98 * (occupied.size() - 1));
   std::nth_element(occupied.begin(), nth, occupied.end());
   const float ref = std::max(*nth, 1e-3f);
-  const cv::Vec3f dark(58, 50, 44), bright(205, 196, 186);
+  const cv::Vec3f dark(54, 47, 42), bright(180, 170, 160);
   for (int r = 0; r < density.rows; ++r) {
     const float* d = density.ptr<float>(r);
     cv::Vec3b* px = img.ptr<cv::Vec3b>(r);
@@ -111,6 +111,7 @@ void drawTracks(cv::Mat& img, const RunSummary& run, const ViewTransform& view) 
     for (const auto& q : footprint(t.last_pose, t.size)) box.push_back(view.fromWorld(q));
     dashedPolygon(img, box, c, 1, 4, 3);
   }
+  LabelPlacer labels;
   for (const TrackPath& t : run.tracks) {
     if (!t.is_dynamic || t.positions.empty()) continue;
     const cv::Scalar c = trackColour(t.id);
@@ -122,7 +123,7 @@ void drawTracks(cv::Mat& img, const RunSummary& run, const ViewTransform& view) 
     const Eigen::Vector2d end = px.back();
     const Eigen::Vector2d head = view.fromWorld(t.last_pose * Eigen::Vector3d(1, 0, 0)) - view.fromWorld(t.last_pose.translation());
     if (head.norm() > 1e-9) arrow(img, end, end + head.normalized() * 14.0, c, 2);
-    label(img, strf("%d %s", t.id, t.type.c_str()), cv::Point(static_cast<int>(end.x()) + 8, static_cast<int>(end.y()) + 4), c);
+    labels.place(img, strf("%d %s", t.id, t.type.c_str()), cv::Point(static_cast<int>(end.x()) + 8, static_cast<int>(end.y()) + 4), c);
   }
 }
 
@@ -184,7 +185,7 @@ cv::Mat renderSummary(const RunSummary& run, const DensityMap* map, const Summar
                                       {S::Line, trackColour(0), "dynamic track path: id class"},
                                       {S::DashedBox, trackColour(3), "static track (last pose)"}};
   if (map && !map->empty())
-    entries.push_back({S::Dots, cv::Scalar(120, 110, 100), "map: kept points at the ego estimate", cv::Scalar(205, 196, 186)});
+    entries.push_back({S::Dots, cv::Scalar(110, 100, 92), "map: kept points at the ego estimate", cv::Scalar(180, 170, 160)});
   legend(img, entries);
   scaleBar(img, view.metresPerPixel());
   return img;

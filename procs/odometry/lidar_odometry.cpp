@@ -1,0 +1,157 @@
+#include "lidar_odometry.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "dlslot/box_filter.hpp"
+#include "rigid_motion.hpp"
+#include "scan_to_map.hpp"
+
+namespace dlslot::odometry {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+double angleOf(const Pose& T) { return Eigen::AngleAxisd(T.linear()).angle(); }
+
+// Covariance of the fallback prediction: the configured sigmas.
+Matrix6d fallbackCovariance(const OdometryConfig& cfg) {
+  const double st = cfg.fallback_sigma_m, sr = cfg.fallback_sigma_deg * M_PI / 180.0;
+  Vector6d var;
+  var << st * st, st * st, st * st, sr * sr, sr * sr, sr * sr;
+  return var.asDiagonal();
+}
+
+// Covariance of the refined pose: the scan-to-map information H / sigma^2 plus the fallback's
+// information, so that a degenerate direction is never more certain than the prediction.
+Matrix6d solveCovariance(const Matrix6d& normal_matrix, const OdometryConfig& cfg) {
+  const double s2 = cfg.residual_sigma_m * cfg.residual_sigma_m;
+  const Matrix6d info = normal_matrix / s2 + fallbackCovariance(cfg).inverse();
+  return info.inverse();
+}
+
+}  // namespace
+
+LidarOdometry::LidarOdometry(OdometryConfig cfg)
+    : cfg_(std::move(cfg)),
+      map_(cfg_.scan_to_map.edge_voxel_m, cfg_.scan_to_map.plane_voxel_m, cfg_.scan_to_map.map_radius_m) {}
+
+void LidarOdometry::reset() {
+  map_.clear();
+  reference_ = ScanReference();
+  T_world_reference_ = T_world_last_ = velocity_ = Pose::Identity();
+  started_ = false;
+}
+
+void LidarOdometry::fallBack(Status status, const std::string& why, const Pose& prediction, OdometryResult& out) {
+  out.status = status;
+  out.status_text = why;
+  out.T_world_lidar = prediction;
+  out.delta = T_world_last_.inverse() * prediction;
+  out.covariance = fallbackCovariance(cfg_);
+  T_world_last_ = prediction;
+}
+
+OdometryResult LidarOdometry::process(const Frame& frame, bool detections_available) {
+  const auto t_total = Clock::now();
+  OdometryResult out;
+  out.frame = frame.index;
+  out.num_points_in = static_cast<int>(frame.scan.cols());
+  out.detections_used = cfg_.remove_detected_objects && detections_available;
+
+  // Features, after removing the points of potential dynamic objects (A-LOAM*, paper III-D).
+  auto t = Clock::now();
+  ScanFeatures features;
+  const PointCloud* scan = &frame.scan;
+  PointCloud kept;
+  if (out.detections_used && !frame.detections.empty()) {
+    const std::vector<bool> inside = pointsInBoxes(*scan, frame.detections, cfg_.box_margin_m);
+    for (bool in : inside) out.num_points_removed += in ? 1 : 0;
+    kept = keepOutside(*scan, inside);
+    scan = &kept;
+  }
+  features = extractFeatures(*scan, cfg_.features);
+  out.num_edge = static_cast<int>(features.sharp.size());
+  out.num_plane = static_cast<int>(features.flat.size());
+  out.timings.emplace_back("features", msSince(t));
+
+  const Pose prediction = T_world_last_ * velocity_;
+  auto finish = [&]() -> OdometryResult {
+    out.timings.emplace_back("total", msSince(t_total));
+    return out;
+  };
+  if (features.num_points < cfg_.min_points || static_cast<int>(features.less_sharp.size()) < cfg_.min_edge_features ||
+      static_cast<int>(features.less_flat.size()) < cfg_.min_plane_features) {
+    fallBack(Status::FallbackFewPoints,
+             "too few points or features (" + std::to_string(features.num_points) + " points, " +
+                 std::to_string(features.less_sharp.size()) + " edges, " + std::to_string(features.less_flat.size()) +
+                 " planes)",
+             prediction, out);
+    return finish();
+  }
+
+  // Scan-to-scan: previous scan's edges and planes, from the constant-velocity guess.
+  t = Clock::now();
+  Registration s2s;
+  s2s.solution.T_ref_cur = Pose::Identity();
+  if (started_) {
+    s2s = registerScanToScan(features, reference_, T_world_reference_.inverse() * prediction, cfg_.scan_to_scan);
+    out.timings.emplace_back("scan_to_scan", msSince(t));
+    if (!s2s.solution.ok) {
+      fallBack(Status::FallbackSolveFailed,
+               "scan-to-scan failed (" + std::to_string(s2s.num_correspondences) + " correspondences)", prediction,
+               out);
+      return finish();
+    }
+  } else {
+    out.timings.emplace_back("scan_to_scan", msSince(t));
+  }
+
+  // Scan-to-map: refine against the local map, then add this scan to it.
+  t = Clock::now();
+  const FeatureCloud edges = downsample(features.less_sharp, cfg_.scan_to_map.edge_voxel_m);
+  const FeatureCloud planes = downsample(features.less_flat, cfg_.scan_to_map.plane_voxel_m);
+  out.num_map_edge = static_cast<int>(map_.edges().size());
+  out.num_map_plane = static_cast<int>(map_.planes().size());
+  Pose pose = Pose::Identity();
+  if (started_) {
+    const Registration s2m =
+        registerScanToMap(edges, planes, map_, T_world_reference_ * s2s.solution.T_ref_cur, cfg_.scan_to_map);
+    const Pose correction = prediction.inverse() * s2m.solution.T_ref_cur;
+    std::string failure;
+    if (!s2m.solution.ok)
+      failure = "scan-to-map failed (" + std::to_string(s2m.num_correspondences) + " correspondences)";
+    else if (correction.translation().norm() > cfg_.max_correction_m ||
+             angleOf(correction) > cfg_.max_correction_deg * M_PI / 180.0)
+      failure = "solution jumped " + std::to_string(correction.translation().norm()) + " m from the prediction";
+    if (!failure.empty()) {
+      out.timings.emplace_back("scan_to_map", msSince(t));
+      fallBack(Status::FallbackSolveFailed, failure, prediction, out);
+      return finish();
+    }
+    pose = s2m.solution.T_ref_cur;
+    out.status = Status::Ok;
+    out.min_eigenvalue = s2m.solution.min_eigenvalue;
+    out.residual_mean = s2m.solution.residual_mean;
+    out.num_correspondences = s2m.num_correspondences;
+    out.covariance = solveCovariance(s2m.solution.normal_matrix, cfg_);
+  } else {
+    out.status = Status::FirstFrame;
+    out.covariance = Matrix6d::Zero();
+    pose = T_world_last_;
+  }
+  map_.insert(edges, planes, pose);
+  out.timings.emplace_back("scan_to_map", msSince(t));
+
+  out.T_world_lidar = pose;
+  out.delta = T_world_last_.inverse() * pose;
+  if (started_) velocity_ = out.delta;
+  T_world_last_ = T_world_reference_ = pose;
+  reference_.reset(features);
+  started_ = true;
+  return finish();
+}
+
+}  // namespace dlslot::odometry

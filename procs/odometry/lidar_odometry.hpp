@@ -1,0 +1,66 @@
+// The odometry of DL-SLOT's front end (paper III-D, A-LOAM): one call per scan.
+#pragma once
+
+#include <string>
+
+#include "dlslot/convert.hpp"
+#include "dlslot/types.hpp"
+#include "local_map.hpp"
+#include "odometry_config.hpp"
+#include "scan_to_scan.hpp"
+
+namespace dlslot::odometry {
+
+enum class Status {
+  Ok,
+  FallbackFewPoints,    // too few points or features: constant-velocity prediction
+  FallbackSolveFailed,  // a registration failed or jumped: constant-velocity prediction
+  FirstFrame,           // identity pose, nothing to register against
+};
+
+struct OdometryResult {
+  int frame = 0;
+  Status status = Status::Ok;
+  std::string status_text;         // why, when status != Ok
+  bool detections_used = false;    // points inside detected boxes were removed (A-LOAM*)
+  Pose T_world_lidar = Pose::Identity();
+  Pose delta = Pose::Identity();   // T_prev_cur
+  Matrix6d covariance = Matrix6d::Identity();  // of delta, tangent (t, rotation), m and rad
+  double min_eigenvalue = 0.0;     // of the scan-to-map normal matrix
+  int num_points_in = 0;
+  int num_points_removed = 0;
+  int num_edge = 0, num_plane = 0;            // sharp and flat features
+  int num_map_edge = 0, num_map_plane = 0;    // local map used for scan-to-map
+  int num_correspondences = 0;                // scan-to-map, last search
+  double residual_mean = 0.0;                 // scan-to-map inliers, m
+  StageTimings timings;                       // features, scan_to_scan, scan_to_map, total (ms)
+};
+
+class LidarOdometry {
+ public:
+  explicit LidarOdometry(OdometryConfig cfg = {});
+
+  // One scan: remove the points inside its detected boxes (A-LOAM* mode, when `detections_available`),
+  // extract edge and plane features, register them to the previous scan starting from the
+  // constant-velocity guess, refine against the local map, and add them to the map. A scan
+  // with too few features or a failed solve gets the constant-velocity prediction, flagged.
+  OdometryResult process(const Frame& frame, bool detections_available = true);
+
+  // Forget everything (a new sequence).
+  void reset();
+  const OdometryConfig& config() const { return cfg_; }
+  const LocalMap& map() const { return map_; }
+
+ private:
+  void fallBack(Status status, const std::string& why, const Pose& prediction, OdometryResult& out);
+
+  OdometryConfig cfg_;
+  LocalMap map_;
+  ScanReference reference_;                    // the last registered scan's features
+  Pose T_world_reference_ = Pose::Identity();  // ...and its pose
+  Pose T_world_last_ = Pose::Identity();       // the last published pose
+  Pose velocity_ = Pose::Identity();           // the last delta: constant-velocity model
+  bool started_ = false;
+};
+
+}  // namespace dlslot::odometry

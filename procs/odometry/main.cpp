@@ -1,0 +1,173 @@
+// dlslot-odometry: A-LOAM-style LiDAR odometry on scans with detected objects removed (paper
+// III-D). Joins LIDAR_SCAN and DETECTIONS by frame and publishes ODOMETRY and PROCESS_STATUS;
+// with --offline it reads a KITTI sequence directly and writes the trajectory instead.
+#include <chrono>
+#include <cstdio>
+#include <string>
+
+#include "dlslot/convert.hpp"
+#include "dlslot/detections_t.hpp"
+#include "dlslot/node.hpp"
+#include "dlslot/odometry_t.hpp"
+#include "dlslot/point_cloud_t.hpp"
+#include "lidar_odometry.hpp"
+#include "offline.hpp"
+#include "scan_joiner.hpp"
+
+using namespace dlslot;
+using namespace dlslot::odometry;
+
+namespace {
+
+double secondsNow() { return std::chrono::duration<double>(Node::Clock::now().time_since_epoch()).count(); }
+
+int8_t statusCode(Status s) {
+  switch (s) {
+    case Status::Ok: return odometry_t::STATUS_OK;
+    case Status::FallbackFewPoints: return odometry_t::STATUS_FALLBACK_FEW_POINTS;
+    case Status::FallbackSolveFailed: return odometry_t::STATUS_FALLBACK_SOLVE_FAILED;
+    case Status::FirstFrame: return odometry_t::STATUS_FIRST_FRAME;
+  }
+  return odometry_t::STATUS_FALLBACK_SOLVE_FAILED;
+}
+
+odometry_t toMsg(const OdometryResult& r, int64_t utime) {
+  odometry_t m;
+  m.utime = utime;
+  m.frame = r.frame;
+  m.status = statusCode(r.status);
+  m.status_text = r.status_text;
+  m.detections_used = r.detections_used;
+  m.pose = dlslot::toMsg(r.T_world_lidar);
+  m.delta = dlslot::toMsg(r.delta);
+  dlslot::toMsg(r.covariance, m.covariance);
+  m.min_eigenvalue = r.min_eigenvalue;
+  m.num_points_in = r.num_points_in;
+  m.num_points_removed = r.num_points_removed;
+  m.num_edge = r.num_edge;
+  m.num_plane = r.num_plane;
+  m.num_map_edge = r.num_map_edge;
+  m.num_map_plane = r.num_map_plane;
+  m.residual_mean = r.residual_mean;
+  m.num_correspondences = r.num_correspondences;
+  m.timings = dlslot::toMsg(r.timings);
+  m.num_timings = static_cast<int32_t>(m.timings.size());
+  return m;
+}
+
+int runNode(const NodeOptions& node_opts, const Channels& channels, const OdometryConfig& cfg, double timeout_s) {
+  Node node("odometry", node_opts.lcm_url, channels);
+  ProcessStatus& status = node.status();
+  LidarOdometry odometry(cfg);
+  ScanJoiner joiner(timeout_s, cfg.remove_detected_objects);
+  std::fprintf(stderr, "dlslot-odometry: mode %s\n", modeName(cfg.remove_detected_objects));
+
+  auto process = [&](JoinedScan& joined) {
+    const auto tic = Node::Clock::now();
+    const Frame& frame = joined.frame;
+    if (cfg.remove_detected_objects && !joined.has_detections) {
+      status.timeout(channels.detections + " for frame " + std::to_string(frame.index) + " not within " +
+                     std::to_string(timeout_s) + " s; ran unfiltered");
+      status.count("unfiltered_frames");
+    }
+    OdometryResult r;
+    try {
+      r = odometry.process(frame, joined.has_detections);
+    } catch (const std::exception& e) {  // never take the pipeline down for one scan
+      status.error("frame " + std::to_string(frame.index) + ": " + e.what() + "; odometry reset");
+      odometry.reset();
+      return;
+    }
+    if (r.status == Status::FallbackFewPoints || r.status == Status::FallbackSolveFailed) {
+      status.warn("frame " + std::to_string(frame.index) + ": " + r.status_text + "; constant-velocity prediction");
+      status.count("fallback_frames");
+    }
+    if (cfg.remove_detected_objects && !joined.has_detections)
+      r.status_text += (r.status_text.empty() ? "" : "; ") + channels.detections + " timed out, ran unfiltered";
+    node.publish(channels.odometry, toMsg(r, frame.utime));
+    status.frameDone(frame.index, std::chrono::duration<double, std::milli>(Node::Clock::now() - tic).count());
+  };
+  auto releaseReady = [&] {
+    for (JoinedScan& joined : joiner.release(secondsNow())) process(joined);
+  };
+  // A frame at or before one already handled: the input restarted (a new run). Start over.
+  auto restartIfRewound = [&](int frame) {
+    if (joiner.lastReleased() < 0 || frame > joiner.lastReleased()) return;
+    status.warn("frame " + std::to_string(frame) + " after frame " + std::to_string(joiner.lastReleased()) +
+                ": input restarted, odometry reset");
+    joiner.reset();
+    odometry.reset();
+  };
+
+  node.subscribeFrames<point_cloud_t>(channels.scan, [&](const point_cloud_t& msg) {
+    restartIfRewound(msg.frame);
+    joiner.addScan(msg.frame, msg.utime, fromMsg(msg), secondsNow());
+    releaseReady();
+  });
+  node.subscribeFrames<detections_t>(channels.detections, [&](const detections_t& msg) {
+    std::vector<Box> boxes;
+    int rejected = 0;
+    for (const box_t& b : msg.boxes) {
+      if (isValid(b))
+        boxes.push_back(fromMsg(b));
+      else
+        ++rejected;
+    }
+    if (rejected > 0) {
+      status.error(channels.detections + " frame " + std::to_string(msg.frame) + ": " + std::to_string(rejected) +
+                   " malformed box(es) (NaN/inf field or size <= 0) ignored");
+      status.count("rejected_detections", rejected);
+    }
+    if (!joiner.addDetections(msg.frame, std::move(boxes), secondsNow())) status.count("stale_messages");
+    releaseReady();
+  });
+  node.every(0.02, releaseReady);
+  return node.run();
+}
+
+int run(int argc, char** argv) {
+  NodeOptions node_opts;
+  OfflineOptions offline;
+  std::string mode;
+  bool run_offline = false;
+  CommandLine cl("dlslot-odometry",
+                 "A-LOAM-style LiDAR odometry with detected-object point removal (DL-SLOT III-D).\n"
+                 "Subscribes LIDAR_SCAN and DETECTIONS; publishes ODOMETRY and PROCESS_STATUS.\n"
+                 "With --offline, reads a KITTI sequence and writes its trajectory (KITTI 3x4 poses).");
+  cl.option("--mode", &mode, "aloam (raw scans) or aloam-filtered (A-LOAM*: detected objects removed); "
+                             "overrides the config");
+  cl.flag("--offline", &run_offline, "no LCM: read --kitti/--sequence, write --out");
+  cl.option("--kitti", &offline.root, "offline: KITTI root (holding training/ or sequences/)");
+  cl.option("--sequence", &offline.sequence, "offline: sequence name, e.g. 0000 or 07");
+  cl.repeated("--detections", &offline.detections, "offline: detection file or directory (repeatable)");
+  cl.option("--out", &offline.out, "offline: trajectory file to write");
+  cl.flag("--quiet", &offline.quiet, "offline: no progress line");
+  node_opts.addTo(cl);
+  if (!cl.parse(argc, argv)) return 0;
+
+  ConfigSection root_cfg = loadConfig(node_opts.config);
+  Channels channels;
+  channels.read(root_cfg.section("channels"));
+  ConfigSection section = root_cfg.section("odometry");
+  OdometryConfig cfg = readOdometryConfig(section);
+  const double timeout_s = section.get<double>("detections_timeout_s");
+  section.finish();
+  if (!(timeout_s > 0)) throw ConfigError(node_opts.config + ": odometry.detections_timeout_s: expected > 0");
+  // The offline driver reads detections as the player would publish them.
+  ConfigSection player = root_cfg.section("player");
+  player.get("min_detection_score", offline.min_detection_score);
+  player.get("frame_period_s", offline.frame_period_s);
+  if (!mode.empty()) cfg.remove_detected_objects = removesDetectedObjects(mode);
+  if (node_opts.check_config) return 0;
+
+  if (run_offline) {
+    if (offline.root.empty() || offline.sequence.empty() || offline.out.empty())
+      throw std::invalid_argument("--offline needs --kitti ROOT, --sequence S and --out FILE");
+    return runOffline(offline, cfg);
+  }
+  return runNode(node_opts, channels, cfg, timeout_s);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return runMain("dlslot-odometry", [&] { return run(argc, argv); }); }

@@ -1,0 +1,91 @@
+// Every parameter of the odometry, with A-LOAM's KITTI (HDL-64) values as defaults. The node
+// reads them from the `odometry:` section of config/dlslot.yaml (odometry_config.cpp).
+#pragma once
+
+#include <string>
+
+#include "dlslot/config.hpp"
+
+namespace dlslot::odometry {
+
+// Feature extraction (A-LOAM scanRegistration; LOAM section V-A).
+struct FeatureConfig {
+  // "hdl64": A-LOAM's piecewise rule for the KITTI HDL-64E (uses beams 0..50 only);
+  // "uniform": num_beams lasers evenly spaced from max_vertical_deg (beam 0) to min_vertical_deg.
+  std::string beam_model = "hdl64";
+  int num_beams = 64;
+  double min_vertical_deg = -24.9;
+  double max_vertical_deg = 2.0;
+  double min_range_m = 5.0;            // closer points hit the vehicle or are too dense
+  int curvature_half_window = 5;       // neighbours on each side used for curvature
+  double max_azimuth_gap_deg = 1.0;    // a larger step between ring neighbours is a gap
+  int sectors_per_beam = 6;            // features are picked evenly around each ring
+  double edge_curvature_min = 0.1;     // curvature above: edge candidate
+  double plane_curvature_max = 0.1;    // curvature below: plane candidate
+  int sharp_per_sector = 2;
+  int less_sharp_per_sector = 20;
+  int flat_per_sector = 4;
+  int suppression_half_window = 5;     // neighbours of a picked point that cannot be picked
+  double suppression_max_gap_m = 0.2236;  // ...unless separated by a larger gap (sqrt(0.05))
+  double less_flat_spacing_m = 0.2;    // along-ring spacing of the less-flat points kept
+};
+
+// One Ceres registration: correspondences are searched `outer_iterations` times, each followed
+// by `solver_iterations` Levenberg-Marquardt steps with a Huber loss.
+struct SolverConfig {
+  int outer_iterations = 2;
+  int solver_iterations = 4;
+  double huber_delta_m = 0.1;
+};
+
+// Scan-to-scan odometry (A-LOAM laserOdometry).
+struct ScanToScanConfig {
+  SolverConfig solver;
+  double max_match_distance_m = 5.0;  // nearest previous feature farther than this: no match
+  int nearby_beams = 2;               // second/third match points come from beams this close
+  int min_correspondences = 30;
+};
+
+// Scan-to-map refinement against a local map (A-LOAM laserMapping).
+struct ScanToMapConfig {
+  SolverConfig solver;
+  double edge_voxel_m = 0.4;          // voxel size of the edge map and of the scan's edge queries
+  double plane_voxel_m = 0.8;         // same for planes
+  int neighbors = 5;                  // map points fitted to a line or plane per query
+  double max_neighbor_distance_m = 1.0;
+  double edge_eigen_ratio = 3.0;      // largest/second eigenvalue of a line's neighbours
+  double plane_max_deviation_m = 0.2; // every neighbour must be this close to the fitted plane
+  double map_radius_m = 100.0;        // map points farther (horizontally) from the vehicle are dropped
+  int min_correspondences = 50;
+};
+
+struct OdometryConfig {
+  FeatureConfig features;
+  ScanToScanConfig scan_to_scan;
+  ScanToMapConfig scan_to_map;
+  // Paper III-D: A-LOAM* removes the points of detected objects before feature extraction.
+  bool remove_detected_objects = true;
+  double box_margin_m = 0.3;          // boxes are grown by this on every side
+  int min_points = 1000;              // fewer points after filtering: constant-velocity fallback
+  int min_edge_features = 10;
+  int min_plane_features = 50;
+  // A solved pose farther than this from the constant-velocity prediction is a failed solve.
+  double max_correction_m = 2.0;
+  double max_correction_deg = 10.0;
+  // Covariance of delta = residual_sigma^2 * inverse(scan-to-map normal matrix), no direction
+  // less certain than the fallback sigmas (which are also the fallback's covariance).
+  double residual_sigma_m = 0.05;
+  double fallback_sigma_m = 1.0;
+  double fallback_sigma_deg = 5.0;
+};
+
+// Parses a mode name: "aloam" (no removal) or "aloam-filtered" (A-LOAM*); throws
+// std::invalid_argument for anything else.
+bool removesDetectedObjects(const std::string& mode);
+const char* modeName(bool remove_detected_objects);
+
+// Reads every key of the odometry section (sub-sections are finished here; the caller
+// reads its own node-only keys from `section` and then calls section.finish()).
+OdometryConfig readOdometryConfig(ConfigSection& section);
+
+}  // namespace dlslot::odometry

@@ -1,0 +1,72 @@
+#include "offline.hpp"
+
+#include <cstdio>
+#include <map>
+
+#include "dlslot/kitti.hpp"
+#include "dlslot/progress.hpp"
+#include "dlslot/timing_stats.hpp"
+#include "lidar_odometry.hpp"
+
+namespace dlslot::odometry {
+
+namespace {
+
+const char* statusName(Status s) {
+  switch (s) {
+    case Status::Ok: return "ok";
+    case Status::FallbackFewPoints: return "fallback (few points)";
+    case Status::FallbackSolveFailed: return "fallback (solve failed)";
+    case Status::FirstFrame: return "first frame";
+  }
+  return "?";
+}
+
+}  // namespace
+
+int runOffline(const OfflineOptions& opts, const OdometryConfig& cfg) {
+  kitti::SequenceReader reader(opts.root, opts.sequence, opts.detections, opts.min_detection_score,
+                               opts.frame_period_s);
+  if (cfg.remove_detected_objects && opts.detections.empty())
+    std::fprintf(stderr, "dlslot-odometry: mode aloam-filtered without --detections: nothing is removed\n");
+  LidarOdometry odometry(cfg);
+  std::vector<Pose> poses;
+  std::vector<std::string> stage_order;
+  std::map<std::string, TimingStats> stages;
+  std::map<Status, int> statuses;
+  long removed = 0, points = 0;
+  ProgressLine progress("odometry " + opts.sequence + " (" + modeName(cfg.remove_detected_objects) + ")",
+                        reader.size());
+  for (int i = 0; i < reader.size(); ++i) {
+    const OdometryResult r = odometry.process(reader.read(i), !opts.detections.empty());
+    poses.push_back(r.T_world_lidar);
+    ++statuses[r.status];
+    if (r.status == Status::FallbackFewPoints || r.status == Status::FallbackSolveFailed)
+      std::fprintf(stderr, "\nframe %d: %s: %s\n", i, statusName(r.status), r.status_text.c_str());
+    removed += r.num_points_removed;
+    points += r.num_points_in;
+    for (const auto& [name, ms] : r.timings) {
+      if (!stages.count(name)) stage_order.push_back(name);
+      stages[name].add(ms);
+    }
+    if (!opts.quiet) progress.update(i + 1);
+  }
+  if (!opts.quiet) progress.finish();
+  kitti::writePoses(opts.out, poses);
+
+  std::printf("wrote %zu poses to %s\n", poses.size(), opts.out.c_str());
+  std::printf("mode %s: %.2f %% of the points removed as detected objects\n", modeName(cfg.remove_detected_objects),
+              points > 0 ? 100.0 * removed / points : 0.0);
+  for (const auto& [status, n] : statuses) std::printf("  %-26s %d frames\n", statusName(status), n);
+  std::printf("%-14s %9s %9s %9s   (ms per frame)\n", "stage", "mean", "p95", "max");
+  for (const std::string& name : stage_order)
+    std::printf("%-14s %9.2f %9.2f %9.2f\n", name.c_str(), stages[name].mean(), stages[name].percentile(95),
+                stages[name].max());
+  if (!poses.empty()) {
+    const Eigen::Vector3d p = poses.back().translation();
+    std::printf("final position %.3f %.3f %.3f m\n", p.x(), p.y(), p.z());
+  }
+  return 0;
+}
+
+}  // namespace dlslot::odometry

@@ -124,11 +124,11 @@ void drawTracks(cv::Mat& img, const RenderInput& in, const ViewTransform& view, 
   LabelPlacer labels;
   for (const TrackState& t : in.tracks) {
     const Polygon p = project(footprint(t.pose, t.size), view.worldToPixel());
-    Eigen::Vector2d top = p[0];
-    for (const auto& q : p)
-      if (q.y() < top.y() || (q.y() == top.y() && q.x() > top.x())) top = q;
+    // Right of the box's top edge in the image, clear of its outline and (mostly) of its arrow.
+    double right = p[0].x(), top = p[0].y();
+    for (const auto& q : p) right = std::max(right, q.x()), top = std::min(top, q.y());
     const std::string s = t.is_dynamic ? strf("%d  %.1f m/s", t.id, t.velocity.head<2>().norm()) : strf("%d", t.id);
-    labels.place(img, s, cv::Point(static_cast<int>(top.x()) + 4, static_cast<int>(top.y()) - 4), trackColour(t.id));
+    labels.place(img, s, cv::Point(static_cast<int>(right) + 6, static_cast<int>(top) + 10), trackColour(t.id));
   }
 }
 

@@ -103,7 +103,7 @@ cv::Size textSize(const std::string& s, double scale, int thickness) {
 cv::Rect label(cv::Mat& img, const std::string& s, cv::Point origin, const cv::Scalar& colour, double scale) {
   const cv::Size sz = textSize(s, scale);
   const cv::Rect backdrop(origin.x - 2, origin.y - sz.height - 3, sz.width + 4, sz.height + 6);
-  shade(img, backdrop, 0.6);
+  shade(img, backdrop, 0.75);
   text(img, s, origin, colour, scale);
   return backdrop;
 }

@@ -14,17 +14,29 @@ namespace {
 
 using Path = std::map<int, Eigen::Vector3d>;
 
-// Fits every path and track into the image between the title panel and the bottom edge.
+// Fits the run into the image between the title panel and the bottom edge: every path and track,
+// but with ground truth only what lies within reach of it, so an estimate that diverges cannot
+// shrink the real scene to a dot (it leaves the view and the text says so).
 ViewTransform fitView(const RunSummary& run, const SummaryConfig& cfg) {
   Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
   auto grow = [&](const Eigen::Vector3d& p) {
     lo = lo.cwiseMin(p.head<2>());
     hi = hi.cwiseMax(p.head<2>());
   };
-  for (const Path* path : {&run.odometry_path, &run.slot_path, &run.gt_path})
-    for (const auto& [f, p] : *path) grow(p);
+  for (const auto& [f, p] : run.gt_path) grow(p);
+  // With ground truth, estimates count only within reach of it: drift stays in view,
+  // divergence does not decide the scale.
+  const Eigen::Vector2d gt_lo = lo, gt_hi = hi;
+  const double reach = run.gt_path.empty() ? 1e300 : std::max(50.0, (gt_hi - gt_lo).maxCoeff());
+  auto near = [&](const Eigen::Vector3d& p) {
+    return ((gt_lo - p.head<2>()).cwiseMax(p.head<2>() - gt_hi)).maxCoeff() <= reach;
+  };
+  for (const Path* path : {&run.odometry_path, &run.slot_path})
+    for (const auto& [f, p] : *path)
+      if (near(p)) grow(p);
   for (const TrackPath& t : run.tracks)
-    for (const auto& p : t.positions) grow(p);
+    for (const auto& p : t.positions)
+      if (near(p)) grow(p);
   if (lo.x() > hi.x()) lo = hi = Eigen::Vector2d::Zero();
   const Eigen::Vector2d mid = 0.5 * (lo + hi);
   const Eigen::Vector2d extent = (hi - lo).cwiseMax(40.0) + Eigen::Vector2d(20.0, 20.0);  // >= 40 m, 10 m margins
@@ -87,7 +99,7 @@ double length(const Path& path) {
 // the identity in the same world frame).
 struct PathError {
   int frames = 0;
-  double end = 0, rms = 0;
+  double end = 0, rms = 0, max = 0;
 };
 PathError errorAgainst(const Path& est, const Path& gt) {
   PathError e;
@@ -97,6 +109,7 @@ PathError errorAgainst(const Path& est, const Path& gt) {
     const double d = (p - g->second).norm();
     e.rms += d * d;
     e.end = d;
+    e.max = std::max(e.max, d);
     ++e.frames;
   }
   if (e.frames) e.rms = std::sqrt(e.rms / e.frames);
@@ -171,6 +184,17 @@ cv::Mat renderSummary(const RunSummary& run, const DensityMap* map, const Summar
       if (e.frames) err += strf("    %s: end %.2f m, RMS %.2f m", name, e.end, e.rms);
     }
     lines.push_back({err, colour::kText});
+    for (const auto& [name, path] : {std::pair<const char*, const Path*>{"DL-SLOT", &run.slot_path},
+                                     std::pair<const char*, const Path*>{"odometry", &run.odometry_path}}) {
+      const bool leaves = std::any_of(path->begin(), path->end(), [&](const auto& fp) {
+        const Eigen::Vector2d px = view.fromWorld(fp.second);
+        return px.x() < 0 || px.y() < 0 || px.x() >= img.cols || px.y() >= img.rows;
+      });
+      if (leaves)
+        lines.push_back({strf("%s leaves the view: up to %.1f m from ground truth", name,
+                              errorAgainst(*path, run.gt_path).max),
+                         colour::kWarning});
+    }
   }
   int dynamic = 0;
   for (const TrackPath& t : run.tracks) dynamic += t.is_dynamic;

@@ -236,6 +236,26 @@ TEST(RendererBev, SummaryShowsThePaths) {
   EXPECT_NO_THROW(renderSummary(RunSummary(), nullptr, cfg));  // an empty run
 }
 
+TEST(RendererBev, SummaryKeepsTheSceneInViewWhenAnEstimateDiverges) {
+  RunSummary run;
+  for (int f = 0; f < 100; ++f) {
+    run.gt_path[f] = Eigen::Vector3d(f, 0, 0);
+    run.slot_path[f] = Eigen::Vector3d(f, f < 50 ? 0.0 : 1e4 * (f - 49), 0);  // runs away after frame 49
+  }
+  const SummaryConfig cfg;
+  const cv::Mat img = renderSummary(run, nullptr, cfg);
+  int gt = 0, warning = 0;
+  for (int v = 0; v < img.rows; ++v)
+    for (int u = 0; u < img.cols; ++u) {
+      gt += distance(img, u, v, colour::kGroundTruth) < 30;
+      warning += v < 150 && distance(img, u, v, colour::kWarning) < 40;
+    }
+  // The 99 m ground truth still spans most of the 1600 px width (2 px thick) ...
+  EXPECT_GT(gt, 1500);
+  // ... and the text says DL-SLOT leaves the view.
+  EXPECT_GT(warning, 50);
+}
+
 TEST(RendererConfig, ShippedConfigAndBadLayer) {
   ConfigSection root = loadConfig(std::string(DLSLOT_SOURCE_DIR) + "/config/dlslot.yaml");
   const RendererConfig cfg = readRendererConfig(root);

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <random>
 
-#include "hungarian.hpp"
+#include "dlslot/hungarian.hpp"
 #include "trajectory_associator.hpp"
 
 using namespace dlslot;

@@ -4,7 +4,7 @@
 #include <stdexcept>
 
 #include "dlslot/kitti.hpp"
-#include "hungarian.hpp"
+#include "dlslot/hungarian.hpp"
 
 namespace dlslot::tracker {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <map>
 
-#include "assignment.hpp"
+#include "dlslot/hungarian.hpp"
 
 namespace dlslot::eval {
 namespace {
@@ -71,7 +71,7 @@ std::optional<Hota> evaluateHota(const std::vector<TrackingFrame>& frames, const
       Eigen::MatrixXd score(ng, nh);
       for (int i = 0; i < ng; ++i)
         for (int j = 0; j < nh; ++j) score(i, j) = alignment(gt_idx[t][i], tr_idx[t][j]) * s(i, j);
-      col = minCostAssignment(-score);
+      col = solveAssignment(-score);
     }
     for (size_t a = 0; a < A; ++a) {
       int n = 0;

@@ -5,7 +5,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-namespace dlslot::tracker {
+namespace dlslot {
 
 using Admissible = Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>;
 
@@ -24,4 +24,4 @@ std::vector<int> solveAssignment(const Eigen::MatrixXd& cost);
 // scene are a single trajectory and its detection). Costs of admissible pairs must be finite.
 std::vector<int> solveGatedAssignment(const Eigen::MatrixXd& cost, const Admissible& admissible);
 
-}  // namespace dlslot::tracker
+}  // namespace dlslot

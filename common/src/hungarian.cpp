@@ -1,4 +1,4 @@
-#include "hungarian.hpp"
+#include "dlslot/hungarian.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <numeric>
 #include <stdexcept>
 
-namespace dlslot::tracker {
+namespace dlslot {
 namespace {
 
 // The square-or-wide case (n <= m). Rows are added one at a time; each addition grows a tree of
@@ -136,4 +136,4 @@ std::vector<int> solveGatedAssignment(const Eigen::MatrixXd& cost, const Admissi
   return col_of_row;
 }
 
-}  // namespace dlslot::tracker
+}  // namespace dlslot

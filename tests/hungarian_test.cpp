@@ -6,11 +6,11 @@
 #include <limits>
 #include <random>
 
-#include "hungarian.hpp"
+#include "dlslot/hungarian.hpp"
 
-using dlslot::tracker::Admissible;
-using dlslot::tracker::solveAssignment;
-using dlslot::tracker::solveGatedAssignment;
+using dlslot::Admissible;
+using dlslot::solveAssignment;
+using dlslot::solveGatedAssignment;
 
 namespace {
 

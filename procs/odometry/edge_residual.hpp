@@ -12,13 +12,14 @@ namespace dlslot::odometry {
 
 class EdgeResidual final : public ceres::SizedCostFunction<3, 6> {
  public:
-  // p: point in the current frame; a: a point of the line and u its unit direction, reference frame.
-  EdgeResidual(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& u)
-      : p_(p), a_(a), P_(Eigen::Matrix3d::Identity() - u * u.transpose()) {}
+  // p: point in the current frame; a: a point of the line and u its unit direction, reference
+  // frame; motion: shared by the residuals of one problem (see RigidMotion).
+  EdgeResidual(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& u, RigidMotion& motion)
+      : p_(p), a_(a), P_(Eigen::Matrix3d::Identity() - u * u.transpose()), motion_(motion) {}
 
   bool Evaluate(double const* const* x, double* residual, double** jacobian) const override {
     Matrix36d J;
-    const Eigen::Vector3d q = transformPoint(x[0], p_, jacobian && jacobian[0] ? &J : nullptr);
+    const Eigen::Vector3d q = motion_.at(x[0]).apply(p_, jacobian && jacobian[0] ? &J : nullptr);
     Eigen::Map<Eigen::Vector3d> r(residual);
     r = P_ * (q - a_);
     if (jacobian && jacobian[0]) {
@@ -31,6 +32,7 @@ class EdgeResidual final : public ceres::SizedCostFunction<3, 6> {
  private:
   Eigen::Vector3d p_, a_;
   Eigen::Matrix3d P_;  // projector onto the plane perpendicular to the line
+  RigidMotion& motion_;
 };
 
 }  // namespace dlslot::odometry

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <utility>
 
 #include "beam_index.hpp"
 #include "curvature.hpp"
@@ -62,13 +63,13 @@ class RingSelector {
     const int w = cfg_.curvature_half_window;
     const int first = w, last = static_cast<int>(ring_.cols()) - w - 1;  // inclusive
     if (last - first < cfg_.sectors_per_beam) return;
-    std::vector<int> order(ring_.cols());
-    std::iota(order.begin(), order.end(), 0);
+    // (curvature, index) pairs sort faster than indices compared through the curvature array.
+    std::vector<std::pair<float, int>> order(ring_.cols());
+    for (int i = 0; i < static_cast<int>(order.size()); ++i) order[i] = {curvature_[i], i};
     for (int s = 0; s < cfg_.sectors_per_beam; ++s) {
       const int sp = first + (last - first) * s / cfg_.sectors_per_beam;
       const int ep = first + (last - first) * (s + 1) / cfg_.sectors_per_beam - 1;
-      std::sort(order.begin() + sp, order.begin() + ep + 1,
-                [this](int a, int b) { return curvature_[a] < curvature_[b]; });
+      std::sort(order.begin() + sp, order.begin() + ep + 1);
       pickEdges(order, sp, ep, beam, out);
       pickFlats(order, sp, ep, beam, out);
     }
@@ -83,10 +84,10 @@ class RingSelector {
   }
 
  private:
-  void pickEdges(const std::vector<int>& order, int sp, int ep, int beam, ScanFeatures& out) {
+  void pickEdges(const std::vector<std::pair<float, int>>& order, int sp, int ep, int beam, ScanFeatures& out) {
     int n = 0;
     for (int k = ep; k >= sp && n < cfg_.less_sharp_per_sector; --k) {
-      const int i = order[k];
+      const int i = order[k].second;
       if (curvature_[i] <= cfg_.edge_curvature_min) break;
       if (picked_[i]) continue;
       ++n;
@@ -97,10 +98,10 @@ class RingSelector {
     }
   }
 
-  void pickFlats(const std::vector<int>& order, int sp, int ep, int beam, ScanFeatures& out) {
+  void pickFlats(const std::vector<std::pair<float, int>>& order, int sp, int ep, int beam, ScanFeatures& out) {
     int n = 0;
     for (int k = sp; k <= ep && n < cfg_.flat_per_sector; ++k) {
-      const int i = order[k];
+      const int i = order[k].second;
       if (curvature_[i] >= cfg_.plane_curvature_max) break;
       if (picked_[i]) continue;
       ++n;

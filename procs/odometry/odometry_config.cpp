@@ -18,6 +18,8 @@ void readSolver(ConfigSection s, SolverConfig& c) {
   s.get("outer_iterations", c.outer_iterations);
   s.get("solver_iterations", c.solver_iterations);
   s.get("huber_delta_m", c.huber_delta_m);
+  s.get("converged_step_m", c.converged_step_m);
+  s.get("converged_step_deg", c.converged_step_deg);
   s.finish();
 }
 
@@ -52,6 +54,7 @@ void readScanToScan(ConfigSection s, ScanToScanConfig& c) {
   readSolver(s.section("solver"), c.solver);
   s.get("max_match_distance_m", c.max_match_distance_m);
   s.get("nearby_beams", c.nearby_beams);
+  s.get("candidates", c.candidates);
   s.get("min_correspondences", c.min_correspondences);
   s.finish();
 }

@@ -30,12 +30,15 @@ struct FeatureConfig {
   double less_flat_spacing_m = 0.2;    // along-ring spacing of the less-flat points kept
 };
 
-// One Ceres registration: correspondences are searched `outer_iterations` times, each followed
-// by `solver_iterations` Levenberg-Marquardt steps with a Huber loss.
+// One Ceres registration: correspondences are searched up to `outer_iterations` times, each
+// followed by `solver_iterations` Levenberg-Marquardt steps with a Huber loss; a solve that moves
+// the pose less than converged_step_* ends the loop (a new search would find the same pairs).
 struct SolverConfig {
   int outer_iterations = 2;
   int solver_iterations = 4;
   double huber_delta_m = 0.1;
+  double converged_step_m = 0.02;
+  double converged_step_deg = 0.1;
 };
 
 // Scan-to-scan odometry (A-LOAM laserOdometry).
@@ -43,6 +46,7 @@ struct ScanToScanConfig {
   SolverConfig solver;
   double max_match_distance_m = 5.0;  // nearest previous feature farther than this: no match
   int nearby_beams = 2;               // second/third match points come from beams this close
+  int candidates = 10;                // ...among this many nearest previous points
   int min_correspondences = 30;
 };
 

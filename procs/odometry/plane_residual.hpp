@@ -11,12 +11,14 @@ namespace dlslot::odometry {
 
 class PlaneResidual final : public ceres::SizedCostFunction<1, 6> {
  public:
-  // p: point in the current frame; n (unit) and d: the plane in the reference frame.
-  PlaneResidual(const Eigen::Vector3d& p, const Eigen::Vector3d& n, double d) : p_(p), n_(n), d_(d) {}
+  // p: point in the current frame; n (unit) and d: the plane in the reference frame; motion:
+  // shared by the residuals of one problem (see RigidMotion).
+  PlaneResidual(const Eigen::Vector3d& p, const Eigen::Vector3d& n, double d, RigidMotion& motion)
+      : p_(p), n_(n), d_(d), motion_(motion) {}
 
   bool Evaluate(double const* const* x, double* residual, double** jacobian) const override {
     Matrix36d J;
-    const Eigen::Vector3d q = transformPoint(x[0], p_, jacobian && jacobian[0] ? &J : nullptr);
+    const Eigen::Vector3d q = motion_.at(x[0]).apply(p_, jacobian && jacobian[0] ? &J : nullptr);
     residual[0] = n_.dot(q) + d_;
     if (jacobian && jacobian[0]) {
       Eigen::Map<Eigen::Matrix<double, 1, 6>> dr(jacobian[0]);
@@ -28,6 +30,7 @@ class PlaneResidual final : public ceres::SizedCostFunction<1, 6> {
  private:
   Eigen::Vector3d p_, n_;
   double d_;
+  RigidMotion& motion_;
 };
 
 }  // namespace dlslot::odometry

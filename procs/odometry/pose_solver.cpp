@@ -43,8 +43,9 @@ void measureConstraint(const Matches& m, const ceres::LossFunction& loss, double
       ++s.num_inliers;
     }
   };
-  for (const EdgeMatch& e : m.edges) add(EdgeResidual(e.p, e.a, e.u), 3);
-  for (const PlaneMatch& p : m.planes) add(PlaneResidual(p.p, p.n, p.d), 1);
+  RigidMotion motion;
+  for (const EdgeMatch& e : m.edges) add(EdgeResidual(e.p, e.a, e.u, motion), 3);
+  for (const PlaneMatch& p : m.planes) add(PlaneResidual(p.p, p.n, p.d, motion), 1);
   s.residual_mean = s.num_inliers > 0 ? sum_abs / s.num_inliers : 0.0;
   s.min_eigenvalue = Eigen::SelfAdjointEigenSolver<Matrix6d>(s.normal_matrix, Eigen::EigenvaluesOnly).eigenvalues()[0];
 }
@@ -60,15 +61,17 @@ PoseSolution solvePose(const Matches& matches, const Pose& guess, const SolverCo
   const Matches local = expressedIn(matches, guess);
   double x[6] = {0, 0, 0, 0, 0, 0};
   ceres::HuberLoss loss(cfg.huber_delta_m);
+  RigidMotion motion;  // outlives the problem's residuals, which refer to it
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.enable_fast_removal = false;
   ceres::Problem problem(problem_options);
-  for (const EdgeMatch& e : local.edges) problem.AddResidualBlock(new EdgeResidual(e.p, e.a, e.u), &loss, x);
-  for (const PlaneMatch& p : local.planes) problem.AddResidualBlock(new PlaneResidual(p.p, p.n, p.d), &loss, x);
+  for (const EdgeMatch& e : local.edges) problem.AddResidualBlock(new EdgeResidual(e.p, e.a, e.u, motion), &loss, x);
+  for (const PlaneMatch& p : local.planes)
+    problem.AddResidualBlock(new PlaneResidual(p.p, p.n, p.d, motion), &loss, x);
 
   ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
+  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;  // 6 unknowns: the normal matrix is tiny
   options.max_num_iterations = cfg.solver_iterations;
   options.num_threads = 1;
   options.logging_type = ceres::SILENT;
@@ -93,8 +96,14 @@ Registration registerIteratively(const std::function<Matches(const Pose&)>& matc
       r.solution.ok = false;
       break;
     }
-    r.solution = solvePose(m, r.solution.T_ref_cur, cfg);
+    const Pose before = r.solution.T_ref_cur;
+    r.solution = solvePose(m, before, cfg);
     if (!r.solution.ok) break;
+    // Correspondences searched at a pose this close to the solution would be the same ones.
+    const Pose step = before.inverse() * r.solution.T_ref_cur;
+    if (step.translation().norm() < cfg.converged_step_m &&
+        Eigen::AngleAxisd(step.linear()).angle() < cfg.converged_step_deg * M_PI / 180.0)
+      break;
   }
   return r;
 }

@@ -51,8 +51,9 @@ struct Registration {
   int num_correspondences = 0;  // of the last correspondence search
 };
 
-// The outer loop of A-LOAM's odometry and mapping: cfg.outer_iterations times, search
-// correspondences at the current estimate (`match`) and solve. Fails (solution.ok false) when a
+// The outer loop of A-LOAM's odometry and mapping: up to cfg.outer_iterations times, search
+// correspondences at the current estimate (`match`) and solve; stops early once a solve moves
+// the estimate less than cfg.converged_step_*. Fails (solution.ok false) when a
 // search finds fewer than min_correspondences or a solve fails.
 Registration registerIteratively(const std::function<Matches(const Pose&)>& match, const Pose& guess,
                                  const SolverConfig& cfg, int min_correspondences);

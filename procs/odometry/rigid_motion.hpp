@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 #include "dlslot/types.hpp"
@@ -53,15 +54,35 @@ inline Pose orthonormalized(const Pose& T) {
   return out;
 }
 
-// p_ref = Exp(w) p + t, and when J is given its Jacobian d p_ref / d x = [I, -[Exp(w) p]x J_l(w)].
-inline Eigen::Vector3d transformPoint(const double* x, const Eigen::Vector3d& p, Matrix36d* J) {
-  const Eigen::Vector3d w(x[3], x[4], x[5]);
-  const Eigen::Vector3d Rp = expSO3(w) * p;
-  if (J) {
-    J->leftCols<3>().setIdentity();
-    J->rightCols<3>() = -skew(Rp) * leftJacobianSO3(w);
+// x = [t; w] evaluated once for many points: p_ref = Exp(w) p + t and, when J is given, its
+// Jacobian d p_ref / d x = [I, -[Exp(w) p]x J_l(w)]. Ceres evaluates all residual blocks of a
+// registration at the same x in a row (single-threaded), so they share one RigidMotion and the
+// rotation and its Jacobian are computed once per x, not once per point.
+class RigidMotion {
+ public:
+  const RigidMotion& at(const double* x) {
+    if (!std::equal(x, x + 6, x_)) {
+      std::copy(x, x + 6, x_);
+      const Eigen::Vector3d w(x[3], x[4], x[5]);
+      R_ = expSO3(w);
+      Jl_ = leftJacobianSO3(w);
+      t_ = Eigen::Vector3d(x[0], x[1], x[2]);
+    }
+    return *this;
   }
-  return Rp + Eigen::Vector3d(x[0], x[1], x[2]);
-}
+  Eigen::Vector3d apply(const Eigen::Vector3d& p, Matrix36d* J) const {
+    const Eigen::Vector3d Rp = R_ * p;
+    if (J) {
+      J->leftCols<3>().setIdentity();
+      J->rightCols<3>() = -skew(Rp) * Jl_;
+    }
+    return Rp + t_;
+  }
+
+ private:
+  double x_[6] = {NAN, NAN, NAN, NAN, NAN, NAN};  // never equal: the first at() computes
+  Eigen::Matrix3d R_, Jl_;
+  Eigen::Vector3d t_;
+};
 
 }  // namespace dlslot::odometry

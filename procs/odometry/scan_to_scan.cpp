@@ -16,35 +16,29 @@ namespace {
 Eigen::Vector3d vec(const pcl::PointXYZI& p) { return {p.x, p.y, p.z}; }
 int beamOf(const pcl::PointXYZI& p) { return static_cast<int>(p.intensity); }
 
-// Nearest reference point to q, or -1 when farther than max_dist2.
-int nearest(const pcl::KdTreeFLANN<pcl::PointXYZI>& tree, const pcl::PointXYZI& q, double max_dist2) {
-  std::vector<int> idx(1);
-  std::vector<float> d2(1);
-  if (tree.nearestKSearch(q, 1, idx, d2) < 1 || d2[0] >= max_dist2) return -1;
-  return idx[0];
+// The reference points nearest to q (closest first) within max_dist2, at most k.
+struct Candidates {
+  std::vector<int> idx;
+  std::vector<float> d2;
+};
+void nearestCandidates(const pcl::KdTreeFLANN<pcl::PointXYZI>& tree, const pcl::PointXYZI& q, int k, double max_dist2,
+                       Candidates& c) {
+  const int n = tree.nearestKSearch(q, k, c.idx, c.d2);
+  int keep = 0;
+  while (keep < n && c.d2[keep] < max_dist2) ++keep;
+  c.idx.resize(keep);
 }
 
-// Closest point to q among the points of `cloud` whose beam satisfies `accept`, walking outwards
-// from index `from` through the beam-ordered cloud until beams are more than `nearby` away.
+// The closest candidate after the first whose beam satisfies `accept(beam, beam of the first)`
+// and lies within `nearby` beams of it (A-LOAM's rule for the other points of a line or plane).
 template <class Accept>
-int closestInNearbyBeams(const FeatureCloud& cloud, int from, const pcl::PointXYZI& q, int nearby,
-                         double max_dist2, Accept accept) {
-  const int beam0 = beamOf(cloud[from]);
-  int best = -1;
-  double best_d2 = max_dist2;
-  for (int dir : {1, -1}) {
-    for (int j = from + dir; j >= 0 && j < static_cast<int>(cloud.size()); j += dir) {
-      const int beam = beamOf(cloud[j]);
-      if (std::abs(beam - beam0) > nearby) break;
-      if (!accept(beam, beam0)) continue;
-      const double d2 = (vec(cloud[j]) - vec(q)).squaredNorm();
-      if (d2 < best_d2) {
-        best_d2 = d2;
-        best = j;
-      }
-    }
+int closestOf(const Candidates& c, const FeatureCloud& cloud, int nearby, Accept accept) {
+  const int beam0 = beamOf(cloud[c.idx[0]]);
+  for (size_t k = 1; k < c.idx.size(); ++k) {
+    const int beam = beamOf(cloud[c.idx[k]]);
+    if (std::abs(beam - beam0) <= nearby && accept(beam, beam0)) return c.idx[k];
   }
-  return best;
+  return -1;
 }
 
 }  // namespace
@@ -52,6 +46,7 @@ int closestInNearbyBeams(const FeatureCloud& cloud, int from, const pcl::PointXY
 Matches matchScanToScan(const ScanFeatures& current, const ScanReference& previous, const Pose& T_prev_cur,
                         const ScanToScanConfig& cfg) {
   Matches m;
+  Candidates c;
   const double max_d2 = cfg.max_match_distance_m * cfg.max_match_distance_m;
   const Pose T = T_prev_cur;
   auto moved = [&](const pcl::PointXYZI& p) {
@@ -65,11 +60,10 @@ Matches matchScanToScan(const ScanFeatures& current, const ScanReference& previo
   if (!previous.edges().empty()) {
     const FeatureCloud& ref = previous.edges();
     for (const auto& p : current.sharp) {
-      const pcl::PointXYZI q = moved(p);
-      const int a = nearest(previous.edgeTree(), q, max_d2);
-      if (a < 0) continue;
-      const int b = closestInNearbyBeams(ref, a, q, cfg.nearby_beams, max_d2,
-                                         [](int beam, int beam0) { return beam != beam0; });
+      nearestCandidates(previous.edgeTree(), moved(p), cfg.candidates, max_d2, c);
+      if (c.idx.empty()) continue;
+      const int a = c.idx[0];
+      const int b = closestOf(c, ref, cfg.nearby_beams, [](int beam, int beam0) { return beam != beam0; });
       if (b < 0) continue;
       const Eigen::Vector3d pa = vec(ref[a]), pb = vec(ref[b]);
       if ((pb - pa).norm() < 1e-3) continue;
@@ -82,16 +76,14 @@ Matches matchScanToScan(const ScanFeatures& current, const ScanReference& previo
   if (!previous.planes().empty()) {
     const FeatureCloud& ref = previous.planes();
     for (const auto& p : current.flat) {
-      const pcl::PointXYZI q = moved(p);
-      const int a = nearest(previous.planeTree(), q, max_d2);
-      if (a < 0) continue;
-      const int b = closestInNearbyBeams(ref, a, q, cfg.nearby_beams, max_d2,
-                                         [](int beam, int beam0) { return beam == beam0; });
-      const int c = closestInNearbyBeams(ref, a, q, cfg.nearby_beams, max_d2,
-                                         [](int beam, int beam0) { return beam != beam0; });
-      if (b < 0 || c < 0) continue;
+      nearestCandidates(previous.planeTree(), moved(p), cfg.candidates, max_d2, c);
+      if (c.idx.empty()) continue;
+      const int a = c.idx[0];
+      const int b = closestOf(c, ref, cfg.nearby_beams, [](int beam, int beam0) { return beam == beam0; });
+      const int d = closestOf(c, ref, cfg.nearby_beams, [](int beam, int beam0) { return beam != beam0; });
+      if (b < 0 || d < 0) continue;
       const Eigen::Vector3d pa = vec(ref[a]);
-      const Eigen::Vector3d normal = (vec(ref[b]) - pa).cross(vec(ref[c]) - pa);
+      const Eigen::Vector3d normal = (vec(ref[b]) - pa).cross(vec(ref[d]) - pa);
       if (normal.norm() < 1e-6) continue;  // collinear
       const Eigen::Vector3d n = normal.normalized();
       m.planes.push_back({vec(p), n, -n.dot(pa)});

@@ -23,6 +23,7 @@ struct SimObject {
   Eigen::Vector3d size{4.5, 1.8, 1.5};
   std::function<Pose(double t)> pose;  // T_world_object
   std::function<bool(int frame)> visible = [](int) { return true; };
+  bool dynamic_guess = false;  // what the tracker would guess
 };
 
 inline Pose planarPose(double x, double y, double yaw, double z = 0.0) {
@@ -116,6 +117,7 @@ struct SimScene {
           for (int i = 0; i < 3; ++i) obs.box.center[i] = b.translation()[i] + box_noise[i] * n01(rng);
           obs.box.yaw = yawOf(b.linear()) + yaw_noise * n01(rng);
           obs.initialized = ++seen[obj.id] >= init_after;
+          obs.dynamic_guess = obj.dynamic_guess;
           in.observations.push_back(obs);
         }
         auto [lo, hi] = extra.equal_range(f);

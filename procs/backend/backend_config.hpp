@@ -48,7 +48,7 @@ struct BackendConfig {
   int switch_frames = 2;
 
   // Ceres (Levenberg-Marquardt, sparse normal Cholesky).
-  int max_iterations = 10;
+  int max_iterations = 3;
   double function_tolerance = 1e-6;
   double gradient_tolerance = 1e-10;
   double parameter_tolerance = 1e-8;

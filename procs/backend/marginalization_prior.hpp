@@ -8,6 +8,7 @@
 
 #include <ceres/cost_function.h>
 
+#include <memory>
 #include <vector>
 
 #include "backend/se3.hpp"
@@ -16,8 +17,10 @@ namespace dlslot::backend {
 
 class MarginalizationPrior final : public ceres::CostFunction {
  public:
-  // x_lin: one linearization point per block; J: rows x (6 * blocks); r0: rows.
-  MarginalizationPrior(std::vector<Vector7> x_lin, Eigen::MatrixXd J, Eigen::VectorXd r0);
+  // x_lin: one linearization point per block; J: rows x (6 * blocks); r0: rows. H0 = J^T J
+  // and g0 = J^T r0 when the caller has them (the Marginalizer does), else computed.
+  MarginalizationPrior(std::vector<Vector7> x_lin, Eigen::MatrixXd J, Eigen::VectorXd r0,
+                       Eigen::MatrixXd H0 = Eigen::MatrixXd(), Eigen::VectorXd g0 = Eigen::VectorXd());
   // A prior on a single pose (e.g. the first ego pose, which fixes the gauge): r = S (x [-] x0).
   static MarginalizationPrior* CreatePosePrior(const Pose& x0, const Matrix6& sqrt_info);
 
@@ -26,6 +29,15 @@ class MarginalizationPrior final : public ceres::CostFunction {
   // Gauss-Newton terms at x in the blocks' tangent spaces: H = Jx^T Jx and g = Jx^T r(x),
   // without forming Jx^T Jx from the (dense) rows: J^T J and J^T r0 are kept from construction.
   void linearize(double const* const* x, Eigen::MatrixXd& H, Eigen::VectorXd& g) const;
+
+  // The residual rows of block i's tangent and their Jacobians: when J is block upper
+  // triangular (the Marginalizer's Cholesky factor), rows 6i.. touch only blocks i.. . The
+  // solver adds each such row block as its own residual block, so Ceres never multiplies the
+  // zeros (see SlidingWindow::solve).
+  bool isBlockUpperTriangular() const { return upper_triangular_; }
+  bool evaluateRows(int i, double const* const* x, double* residuals, double** jacobians) const;
+  // Those rows as a cost function on blocks i..n-1 (it refers to this prior, which must outlive it).
+  std::unique_ptr<ceres::CostFunction> rowBlock(int i) const;
 
   int numBlocks() const { return static_cast<int>(x_lin_.size()); }
   int numRows() const { return static_cast<int>(r0_.size()); }
@@ -37,6 +49,7 @@ class MarginalizationPrior final : public ceres::CostFunction {
   Eigen::VectorXd r0_;
   Eigen::MatrixXd JtJ_;
   Eigen::VectorXd Jtr0_;
+  bool upper_triangular_ = false;
 };
 
 }  // namespace dlslot::backend

@@ -28,24 +28,39 @@ void applyLoss(const ceres::LossFunction& loss, Eigen::VectorXd& r, Eigen::Matri
   r *= sqrt_rho1 / (1.0 - alpha);
 }
 
-// A^-1 B for a symmetric positive semi-definite A: Cholesky, or a pseudo-inverse when A is
-// singular (a direction no factor constrains carries no information to pass on).
-Eigen::MatrixXd solveSpd(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
-  Eigen::LLT<Eigen::MatrixXd> llt(A);
-  if (llt.info() == Eigen::Success) return llt.solve(B);
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(A);
-  const double eps = 1e-10 * std::max(1.0, es.eigenvalues().cwiseAbs().maxCoeff());
-  const Eigen::VectorXd inv = (es.eigenvalues().array() > eps).select(es.eigenvalues().cwiseInverse(), 0.0);
-  return es.eigenvectors() * inv.asDiagonal() * (es.eigenvectors().transpose() * B);
+// H* = H_rr - H_rm H_mm^-1 H_mr and g* = g_r - H_rm H_mm^-1 g_m for the first nm rows/columns
+// leaving. With H_mm = L L^T and Y = L^-1 [H_mr g_m]: H* = H_rr - Y^T Y (a symmetric rank
+// update). A singular H_mm (a direction no factor constrains, which carries no information to
+// pass on) falls back to the pseudo-inverse.
+void schurComplement(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int nm, Eigen::MatrixXd& H_star,
+                     Eigen::VectorXd& g_star) {
+  const int nr = static_cast<int>(H.rows()) - nm;
+  Eigen::MatrixXd Y(nm, nr + 1);
+  Y << H.topRightCorner(nm, nr), g.head(nm);
+  Eigen::LLT<Eigen::MatrixXd> llt(H.topLeftCorner(nm, nm));
+  if (llt.info() == Eigen::Success) {
+    llt.matrixL().solveInPlace(Y);
+  } else {
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H.topLeftCorner(nm, nm));
+    const double eps = 1e-10 * std::max(1.0, es.eigenvalues().cwiseAbs().maxCoeff());
+    const Eigen::VectorXd inv_sqrt =
+        (es.eigenvalues().array() > eps).select(es.eigenvalues().cwiseMax(eps).cwiseSqrt().cwiseInverse(), 0.0);
+    Y = inv_sqrt.asDiagonal() * (es.eigenvectors().transpose() * Y);
+  }
+  Eigen::MatrixXd S = H.bottomRightCorner(nr, nr);
+  S.selfadjointView<Eigen::Lower>().rankUpdate(Y.leftCols(nr).transpose(), -1.0);
+  H_star = S.selfadjointView<Eigen::Lower>();
+  g_star = g.tail(nr) - Y.leftCols(nr).transpose() * Y.col(nr);
 }
 
-// H = J^T J and g = J^T r  ->  (J, r); J is square (upper triangular when H is definite).
-void factorize(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, Eigen::MatrixXd& J, Eigen::VectorXd& r) {
+// H = J^T J and g = J^T r  ->  (J, r); J is upper triangular when H is definite (returns
+// true), else the eigen-decomposition without the null space (returns false).
+bool factorize(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, Eigen::MatrixXd& J, Eigen::VectorXd& r) {
   Eigen::LLT<Eigen::MatrixXd> llt(H);
   if (llt.info() == Eigen::Success) {
     J = llt.matrixU();
     r = llt.matrixL().solve(g);
-    return;
+    return true;
   }
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H);
   const double eps = 1e-10 * std::max(1.0, es.eigenvalues().cwiseAbs().maxCoeff());
@@ -53,6 +68,7 @@ void factorize(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, Eigen::Matrix
   const Eigen::ArrayXd inv_sqrt = (lambda > 0).select(lambda.sqrt().inverse(), 0.0);
   J = lambda.sqrt().matrix().asDiagonal() * es.eigenvectors().transpose();
   r = inv_sqrt.matrix().asDiagonal() * (es.eigenvectors().transpose() * g);
+  return false;
 }
 
 }  // namespace
@@ -125,23 +141,41 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
   // Schur complement onto the kept blocks.
   Eigen::MatrixXd H_star = H.bottomRightCorner(nr, nr);
   Eigen::VectorXd g_star = g.tail(nr);
-  if (nm > 0) {
-    Eigen::MatrixXd rhs(nm, nr + 1);
-    rhs << H.topRightCorner(nm, nr), g.head(nm);
-    const Eigen::MatrixXd X = solveSpd(H.topLeftCorner(nm, nm), rhs);
-    H_star.noalias() -= H.bottomLeftCorner(nr, nm) * X.leftCols(nr);
-    g_star.noalias() -= H.bottomLeftCorner(nr, nm) * X.col(nr);
+  if (nm > 0) schurComplement(H, g, nm, H_star, g_star);
+
+  // A kept block the eliminated factors say nothing about (e.g. the second pose of an object
+  // whose first one leaves: the pose change used up what its observation said) gets no prior.
+  std::vector<int> informed;
+  for (int k = 0; k < static_cast<int>(kept.size()); ++k)
+    if (H_star.block<6, 6>(6 * k, 6 * k).norm() > 1e-12 * std::max(1.0, H_star.diagonal().cwiseAbs().maxCoeff()))
+      informed.push_back(k);
+  if (informed.empty()) return std::nullopt;
+  if (informed.size() < kept.size()) {
+    std::vector<int> idx;
+    for (int k : informed)
+      for (int d = 0; d < 6; ++d) idx.push_back(6 * k + d);
+    const Eigen::MatrixXd H_full = H_star;
+    const Eigen::VectorXd g_full = g_star;
+    H_star = H_full(idx, idx);
+    g_star = g_full(idx);
+    std::vector<double*> still;
+    for (int k : informed) still.push_back(kept[k]);
+    kept = still;
+    stats_.kept_dim = 6 * static_cast<int>(kept.size());
   }
-  H_star = 0.5 * (H_star + H_star.transpose());
 
   Eigen::MatrixXd J_star;
   Eigen::VectorXd r_star;
-  factorize(H_star, g_star, J_star, r_star);
+  if (!factorize(H_star, g_star, J_star, r_star)) {
+    H_star.resize(0, 0);  // recomputed from J* (the null space was left out)
+    g_star.resize(0);
+  }
   std::vector<Vector7> x_lin;
   x_lin.reserve(kept.size());
   for (double* b : kept) x_lin.push_back(Eigen::Map<const Vector7>(b));
   Factor prior;
-  prior.cost = std::make_shared<MarginalizationPrior>(std::move(x_lin), std::move(J_star), std::move(r_star));
+  prior.cost = std::make_shared<MarginalizationPrior>(std::move(x_lin), std::move(J_star), std::move(r_star),
+                                                     std::move(H_star), std::move(g_star));
   prior.blocks = kept;
   return prior;
 }

@@ -238,6 +238,7 @@ void SlidingWindow::solve(BackendOutput& out) {
   po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  std::vector<std::unique_ptr<ceres::CostFunction>> prior_rows;  // outlives the problem
   ceres::Problem problem(po);
   int variable = 0;
   for (double* b : liveBlocks()) {
@@ -248,12 +249,26 @@ void SlidingWindow::solve(BackendOutput& out) {
       ++variable;
     }
   }
-  for (const Factor& f : factors_) problem.AddResidualBlock(f.cost.get(), f.loss.get(), f.blocks);
+  for (const Factor& f : factors_) {
+    const auto* prior = dynamic_cast<const MarginalizationPrior*>(f.cost.get());
+    if (!prior || !prior->isBlockUpperTriangular()) {
+      problem.AddResidualBlock(f.cost.get(), f.loss.get(), f.blocks);
+      continue;
+    }
+    for (int i = 0; i < prior->numBlocks(); ++i) {
+      prior_rows.push_back(prior->rowBlock(i));
+      problem.AddResidualBlock(prior_rows.back().get(), nullptr,
+                               std::vector<double*>(f.blocks.begin() + i, f.blocks.end()));
+    }
+  }
   out.stats.num_blocks = problem.NumParameterBlocks();
-  out.stats.num_factors = problem.NumResidualBlocks();
+  out.stats.num_factors = static_cast<int>(factors_.size());
   if (variable > 0 && !factors_.empty()) {
     ceres::Solver::Options so;
     so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    // Eigen's sparse Cholesky runs on this thread; SuiteSparse's BLAS spawns threads that only
+    // compete with the other processes for the cores.
+    so.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
     so.max_num_iterations = config_.max_iterations;
     so.function_tolerance = config_.function_tolerance;
     so.gradient_tolerance = config_.gradient_tolerance;

@@ -8,7 +8,7 @@ std::vector<bool> pointsInBoxes(const PointCloud& scan, const std::vector<Box>& 
   std::vector<bool> inside(scan.cols(), false);
   for (const Box& b : boxes) {
     // A cheap bounding-circle test first: most points are far from any box.
-    const double r = 0.5 * std::hypot(b.size.x(), b.size.y()) + margin;
+    const double r = std::hypot(0.5 * b.size.x() + margin, 0.5 * b.size.y() + margin);  // grown box's half-diagonal
     const double r2 = r * r;
     for (Eigen::Index i = 0; i < scan.cols(); ++i) {
       if (inside[i]) continue;

@@ -3,7 +3,6 @@
 // Counters: points per scan, million rays per second.
 #include <benchmark/benchmark.h>
 
-#include <map>
 #include <memory>
 
 #include "sim/simulation.hpp"
@@ -12,14 +11,8 @@ using namespace dlslot;
 
 namespace {
 
-sim::Simulation& simulation(const std::string& name) {
-  static std::map<std::string, std::unique_ptr<sim::Simulation>> cache;
-  auto& s = cache[name];
-  if (!s) {
-    sim::Scenario sc = sim::loadScenario(std::string(DLSLOT_SOURCE_DIR) + "/config/scenarios/" + name + ".yaml");
-    s = std::make_unique<sim::Simulation>(sc);
-  }
-  return *s;
+sim::Scenario scenario(const std::string& name) {
+  return sim::loadScenario(std::string(DLSLOT_SOURCE_DIR) + "/config/scenarios/" + name + ".yaml");
 }
 
 const char* kNames[] = {"urban-static", "intersection", "highway", "parking-lot"};
@@ -27,17 +20,10 @@ const char* kNames[] = {"urban-static", "intersection", "highway", "parking-lot"
 void BM_ScanRayCasting(benchmark::State& state) {
   const std::string name = kNames[state.range(0)];
   state.SetLabel(name);
-  sim::Simulation& sim = simulation(name);
   // The scene half way through the sequence.
-  sim::Simulation fresh(sim.scenario());
+  sim::Simulation sim(scenario(name));
   sim::Simulation::FrameData fd;
-  for (int k = 0; k <= 150; k += 1) {
-    if (k < 150) {
-      fresh.frame(k, 2);
-      continue;
-    }
-    fd = fresh.frame(k, 1);
-  }
+  for (int k = 0; k <= 150; ++k) fd = sim.frame(k, 2);
   long points = 0;
   for (auto _ : state) {
     const sim::Scan s = sim::scan(sim.scenario().sensor, fd.input, static_cast<int>(state.range(1)));
@@ -52,8 +38,7 @@ void BM_ScanRayCasting(benchmark::State& state) {
 void BM_WholeFrame(benchmark::State& state) {
   const std::string name = kNames[state.range(0)];
   state.SetLabel(name);
-  sim::Scenario sc = simulation(name).scenario();
-  sc.frames = 300;
+  const sim::Scenario sc = scenario(name);
   auto sim = std::make_unique<sim::Simulation>(sc);
   int k = 0;
   for (auto _ : state) {

@@ -71,7 +71,7 @@ std::vector<kitti::LabelRow> detect(int frame, const std::vector<DetectorTarget>
                                     const DetectorSpec& spec, const kitti::Calib& calib, Rng& rng) {
   std::vector<kitti::LabelRow> rows;
   for (const DetectorTarget& t : targets) {
-    const double p = spec.max_probability * t.points / (t.points + spec.points_for_half);
+    const double p = spec.max_probability * (1.0 - std::exp(-M_LN2 * t.points / spec.points_for_half));
     if (!rng.chance(p)) continue;
     const Box b = noisy(t.box, spec, rng);
     rows.push_back(detectionRow(frame, t.track_id, b, sigmoid(rng.normal(scoreLogit(t.box.type, t.points), 0.8)), calib));

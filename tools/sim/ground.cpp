@@ -44,28 +44,62 @@ Eigen::Vector3d Ground::normal(const Eigen::Vector2d& p) const {
   return Eigen::Vector3d(-g.x(), -g.y(), 1.0).normalized();
 }
 
-double Ground::intersect(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s) const {
+double Ground::intersect(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double guess) const {
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  // f(s) = height of the ray above the ground. Its rate is at least d_z - G |d_xy| (G: slope
-  // bound), so stepping f / (G |d_xy| - d_z) never passes the first root ("sphere tracing");
-  // Newton polishes the root once the ray is close.
-  const Eigen::Vector2d o2 = o.head<2>(), d2 = d.head<2>();
-  const double descent = slope_bound_ * d2.norm() - d.z();
-  if (descent <= 0) return kInf;  // the ray climbs faster than any slope
-  double s = 0;
-  double f = o.z() - height(o2);
+  // Along the ray each wave is sin(alpha + beta s): f(s) = o_z + s d_z - h(s) is the ray's height
+  // above the ground, f' = d_z - h'(s), and |h'| <= G |d_xy| (G: the slope bound).
+  double alpha[3], beta[3];
+  for (int i = 0; i < 3; ++i) {
+    alpha[i] = waves_[i].k.dot(o.head<2>()) + waves_[i].phase;
+    beta[i] = waves_[i].k.dot(d.head<2>());
+  }
+  auto eval = [&](double s, double& f, double& rate) {
+    double h = 0, dh = 0;
+    for (int i = 0; i < 3; ++i) {
+      double sn, cs;
+      sincos(alpha[i] + beta[i] * s, &sn, &cs);
+      h += waves_[i].amplitude * sn;
+      dh += waves_[i].amplitude * beta[i] * cs;
+    }
+    f = o.z() + s * d.z() - h;
+    rate = d.z() - dh;
+  };
+  const double g_xy = slope_bound_ * d.head<2>().norm();
+  if (d.z() + g_xy < 0) {
+    // Steeper down than any slope: f falls monotonically, one root. Newton, kept inside the
+    // bracket f(lo) > 0 > f(hi) (bisecting, or doubling while hi is unknown, when it leaves it).
+    // The search starts at `guess` (the neighbouring ray's hit): f(0) > 0 as the sensor is above
+    // the ground, so [0, inf) brackets the root from the start.
+    double lo = 0, hi = kInf, s = std::max(0.0, guess), f, rate;
+    eval(s, f, rate);
+    for (int it = 0; it < 60; ++it) {
+      (f > 0 ? lo : hi) = s;
+      if (lo > max_s) return kInf;
+      if (std::abs(f) < 1e-6 || hi - lo < 1e-9) break;
+      const double next = s - f / rate;
+      // A Newton step this small leaves an error of about (f'' / 2 f') step^2 < 1e-9 m on slopes
+      // this gentle: done without another evaluation.
+      if (std::abs(next - s) < 1e-4 && next > lo && next < hi) return next > max_s ? kInf : next;
+      s = next > lo && next < hi ? next : std::isfinite(hi) ? 0.5 * (lo + hi) : 2 * lo + 1;
+      eval(s, f, rate);
+    }
+    return s > max_s ? kInf : s;
+  }
+  // Near-horizontal rays may touch the ground more than once: step f / (G |d_xy| - d_z) at a
+  // time, which never passes the first root ("sphere tracing"), then Newton once close.
+  const double descent = g_xy - d.z();
+  if (descent <= 0) return kInf;  // climbs faster than any slope
+  double s = 0, f, rate;
+  eval(0, f, rate);
   if (f <= 0) return 0.0;
   while (f > 0.05) {
     s += f / descent;
     if (s > max_s) return kInf;
-    f = o.z() + s * d.z() - height(o2 + s * d2);
+    eval(s, f, rate);
   }
-  for (int it = 0; it < 6 && std::abs(f) > 1e-6; ++it) {
-    const Eigen::Vector2d p = o2 + s * d2;
-    const double rate = d.z() - gradient(p).dot(d2);
-    if (rate >= 0) break;  // cannot happen this close above a gentle slope; keep the safe estimate
+  for (int it = 0; it < 6 && std::abs(f) > 1e-6 && rate < 0; ++it) {
     s -= f / rate;
-    f = o.z() + s * d.z() - height(o2 + s * d2);
+    eval(s, f, rate);
   }
   return s > max_s ? kInf : s;
 }

@@ -24,8 +24,9 @@ class Ground {
   double height(const Eigen::Vector2d& p) const;
   Eigen::Vector2d gradient(const Eigen::Vector2d& p) const;
   Eigen::Vector3d normal(const Eigen::Vector2d& p) const;
-  // Distance along the unit ray (o, d) to the ground, or +infinity if beyond max_s.
-  double intersect(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s) const;
+  // Distance along the unit ray (o, d) to the ground, or +infinity if beyond max_s; o must be above
+  // the ground. `guess` (e.g. the previous ray's distance) only speeds the search up.
+  double intersect(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double guess = 0.0) const;
 
   // Paints a road: asphalt over the carriageway, sidewalk out to `clear_m`, dashed lane lines
   // between lanes driving the same way and a solid line between the directions.

@@ -40,6 +40,15 @@ class Rng {
     const double u1 = 1.0 - uniform(), u2 = uniform();
     return mean + sigma * std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
   }
+  // Two independent standard normals from one Box-Muller draw (the hot path: every lidar return).
+  void normalPair(double& a, double& b) {
+    const double u1 = 1.0 - uniform(), u2 = uniform();
+    const double r = std::sqrt(-2.0 * std::log(u1));
+    double s, c;
+    sincos(2.0 * M_PI * u2, &s, &c);
+    a = r * c;
+    b = r * s;
+  }
   // Poisson by inversion (small means only: false positives per frame).
   int poisson(double mean) {
     const double limit = std::exp(-mean);

@@ -113,7 +113,7 @@ struct LabelSpec {
 };
 
 struct DetectorSpec {  // simulated 3D detector (SECOND-like probabilities as scores)
-  double points_for_half = 8.0;   // detection probability reaches half its maximum at this many points
+  double points_for_half = 8.0;   // detection probability p_max (1 - 2^(-points / points_for_half))
   double max_probability = 0.97;
   double position_noise_m = 0.08, position_noise_per_m = 0.003;
   double yaw_noise = 0.04;        // rad

@@ -91,13 +91,15 @@ Scan scan(const SensorSpec& sensor, const ScanInput& in, int threads) {
       const double el = beamElevationDeg(b) * M_PI / 180.0;
       const double ce = std::cos(el), se = std::sin(el);
       BeamPoints& bp = out[b];
+      double ground_guess = 0;  // the previous column's ground distance starts the next search
       for (int a = 0; a < columns; ++a) {
         Rng rng(streamKey({in.key, static_cast<uint64_t>(b), static_cast<uint64_t>(a)}));
         const Eigen::Vector3d dl(ce * cos_az[a], ce * sin_az[a], se);
         const Eigen::Vector3d d = R * dl;
-        double best = world.ground->intersect(o, d, sensor.max_range_m);
+        double best = world.ground->intersect(o, d, sensor.max_range_m, ground_guess);
         int32_t solid = -1, object = -1;
         bool hit = std::isfinite(best);
+        if (hit) ground_guess = best;
         if (!hit) best = sensor.max_range_m;
         double s;
         const int k = world.grid->cast(o, d, best, s, scratch);
@@ -138,8 +140,10 @@ Scan scan(const SensorSpec& sensor, const ScanInput& in, int threads) {
         const double far = best / sensor.max_range_m;
         const double drop = sensor.dropout + 0.5 * (1.0 - refl) * far * far * far * far;
         if (rng.uniform() < drop || incidence < 0.03) continue;
-        const double range = best + rng.normal(0.0, sensor.range_noise_m);
-        const double intensity = std::clamp(refl * (0.4 + 0.6 * incidence) * (1.0 + rng.normal(0.0, 0.1)), 0.0, 1.0);
+        double n_range, n_intensity;
+        rng.normalPair(n_range, n_intensity);
+        const double range = best + sensor.range_noise_m * n_range;
+        const double intensity = std::clamp(refl * (0.4 + 0.6 * incidence) * (1.0 + 0.1 * n_intensity), 0.0, 1.0);
         const Eigen::Vector3d q = range * dl;  // along the beam: the elevation stays the beam's
         bp.xyzi.insert(bp.xyzi.end(), {static_cast<float>(q.x()), static_cast<float>(q.y()), static_cast<float>(q.z()),
                                        static_cast<float>(intensity)});

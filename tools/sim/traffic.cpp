@@ -269,8 +269,8 @@ Motion simulateMotion(const Scenario& sc, const World& world) {
       m.agent = static_cast<int>(agents.size());
       m.path = forward;
       m.lane = key;
-      if (spec.path.crossing_s_m && rng.chance(0.5)) {  // pedestrians cross both ways
-        if (!backward) backward = std::make_shared<Path>(forward->reversed());
+      if (spec.path.crossing_s_m && rng.chance(0.5)) {  // pedestrians cross both ways, keeping right
+        if (!backward) backward = std::make_shared<Path>(forward->reversed().offset(1.2));
         m.path = backward;
         m.lane = key + ":back";
       }

@@ -156,7 +156,8 @@ class RoadsideBuilder {
       double crown = rng_.uniform(1.5, 3.0);
       for (int attempt = 0; attempt < 3; ++attempt, crown *= 0.7) {  // smaller crowns where lanes are close
         const Solid t = Solid::cylinder(c, g - 0.2, g + trunk, rng_.uniform(0.12, 0.3), 0.2f);
-        const Solid k = Solid::sphere(Eigen::Vector3d(c.x(), c.y(), g + trunk + 0.6 * crown), crown, 0.12f);
+        // The crown sits on the trunk: people walk under it.
+        const Solid k = Solid::sphere(Eigen::Vector3d(c.x(), c.y(), g + trunk + crown), crown, 0.12f);
         if (add(StructureKind::Tree, {t, k}, road)) break;
       }
     }
@@ -229,7 +230,7 @@ Path World::pathOf(const PathSpec& spec) const {
   const Road& r = road(spec.road);
   if (spec.crossing_s_m) {  // from one sidewalk to the other, square to the road
     const Path::Sample at = r.centre.at(*spec.crossing_s_m);
-    const double half = 0.5 * r.spec->clear_m - 1.0;
+    const double half = 0.5 * r.spec->clear_m - 0.5;
     return Path::line(at.p - half * leftOf(at.heading), at.p + half * leftOf(at.heading));
   }
   const Path lane = r.centre.offset(spec.lane);
@@ -248,6 +249,8 @@ bool World::keepsOffRoads(const Solid& solid, const Road* own, double lane_half_
         continue;
       }
       if (n.s <= 0 || n.s >= r.centre.length()) continue;  // beyond the road's ends
+      if (std::abs(n.lateral) >= 0.5 * r.spec->carriageway_m) continue;
+      // Inside the carriageway only between lanes (a median barrier).
       for (double lane : r.spec->lanes)
         if (std::abs(n.lateral - lane) < lane_half_m) return false;
     }

@@ -37,9 +37,9 @@ struct World {
   // The curve an agent's (or the ego's) centre follows, in its direction of travel. Lanes left of
   // a road's centreline (positive offsets) run against the road's direction.
   Path pathOf(const PathSpec& spec) const;
-  // True when the solid keeps off every lane of every road (so traffic never drives through it):
-  // its footprint stays `lane_half_m` from each lane centre, and out of other roads' clear zones
-  // unless `own` is that road.
+  // True when the solid keeps off the roads (so traffic never drives through it): out of `own`
+  // road's carriageway (or, inside it, `lane_half_m` from every lane centre: a median), out of
+  // other roads' clear zones, and `lane_half_m` from the ego's and agents' own routes.
   bool keepsOffRoads(const Solid& solid, const Road* own, double lane_half_m = 1.8) const;
 };
 

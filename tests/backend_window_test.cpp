@@ -355,7 +355,9 @@ TEST(BackendSlidingWindow, TwoStageAndOdometryOnlyKeepTheOdometryPoses) {
     } else {
       EXPECT_FALSE(out.back().tracks.empty());
       for (const TrackEstimate& e : out.back().tracks) {
-        if (e.id == 100) EXPECT_NEAR(e.velocity.norm(), 11.0, 1.0);
+        if (e.id == 100) {
+          EXPECT_NEAR(e.velocity.norm(), 11.0, 1.0);
+        }
       }
     }
   }

@@ -71,6 +71,8 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   require(c.observation_loss_scale > 0.0, s, "observation_loss_scale", "a number > 0");
   s.get("static_max_speed", c.static_max_speed);
   require(c.static_max_speed >= 0.0, s, "static_max_speed", "a speed >= 0 (m/s)");
+  s.get("dynamic_min_sigmas", c.dynamic_min_sigmas);
+  require(c.dynamic_min_sigmas >= 0.0, s, "dynamic_min_sigmas", "a number >= 0");
   s.get("switch_distance", c.switch_distance);
   require(c.switch_distance > 0.0, s, "switch_distance", "a distance > 0 (m)");
   s.get("switch_frames", c.switch_frames);

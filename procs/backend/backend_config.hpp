@@ -39,9 +39,11 @@ struct BackendConfig {
   std::string observation_loss = "cauchy";
   double observation_loss_scale = 1.0;
 
-  // A new object whose positions in the window move slower than this (m/s, least-squares
-  // slope) starts as a static landmark; faster ones are dynamic.
+  // A new object is dynamic when the least-squares speed of its positions in the window
+  // exceeds static_max_speed (m/s) and dynamic_min_sigmas standard deviations of that speed
+  // (which box noise alone would cause); else it starts as a static landmark.
   double static_max_speed = 1.0;
+  double dynamic_min_sigmas = 2.0;
   // A landmark turns dynamic when its last `switch_frames` observations each lie farther than
   // `switch_distance` (m, bird's-eye) from it (a parked car pulls out).
   double switch_distance = 0.6;

@@ -1,8 +1,10 @@
 #include "backend/motion_evidence.hpp"
 
+#include <cmath>
+
 namespace dlslot::backend {
 
-std::optional<double> fitSpeed(const std::vector<TimedPosition>& positions) {
+std::optional<SpeedFit> fitSpeed(const std::vector<TimedPosition>& positions, double position_sigma) {
   if (positions.size() < 2) return std::nullopt;
   double t_mean = 0;
   Eigen::Vector2d p_mean = Eigen::Vector2d::Zero();
@@ -19,7 +21,8 @@ std::optional<double> fitSpeed(const std::vector<TimedPosition>& positions) {
     stp += (tp.t - t_mean) * (tp.p.head<2>() - p_mean);
   }
   if (stt < 1e-12) return std::nullopt;
-  return (stp / stt).norm();
+  // Slope variance of a least-squares line: sigma^2 / sum (t - t_mean)^2.
+  return SpeedFit{(stp / stt).norm(), position_sigma / std::sqrt(stt)};
 }
 
 bool leftLandmark(const std::vector<Eigen::Vector3d>& positions, const Eigen::Vector3d& landmark, double distance,

@@ -14,9 +14,15 @@ struct TimedPosition {
   Eigen::Vector3d p = Eigen::Vector3d::Zero();  // world frame
 };
 
-// Bird's-eye speed (m/s) of the least-squares line through the positions; nothing when they
-// span less than two distinct times.
-std::optional<double> fitSpeed(const std::vector<TimedPosition>& positions);
+struct SpeedFit {
+  double speed = 0;  // m/s, bird's-eye
+  double sigma = 0;  // its standard deviation per axis for positions with noise position_sigma
+};
+
+// The least-squares line through the positions; nothing when they span less than two
+// distinct times. A static object's fitted speed is noise of about `sigma` per axis, so a speed
+// of a few sigmas is evidence of motion.
+std::optional<SpeedFit> fitSpeed(const std::vector<TimedPosition>& positions, double position_sigma);
 
 // True when the last `n` positions all lie farther than `distance` (bird's-eye) from `landmark`
 // (false when there are fewer than n).

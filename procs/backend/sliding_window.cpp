@@ -150,8 +150,10 @@ void SlidingWindow::startTrack(Track& track, int frame) {
     const EgoFrame* ego = findFrame(f);
     if (ego) positions.push_back({1e-6 * static_cast<double>(ego->utime), fromBlock(ego->pose->data()) * obs.b.translation()});
   }
-  const std::optional<double> speed = fitSpeed(positions);
-  const bool dynamic = speed ? *speed > config_.static_max_speed : track.dynamic_guess;
+  const double position_sigma = 0.5 * (config_.observation_sigma[0] + config_.observation_sigma[1]);
+  const std::optional<SpeedFit> fit = fitSpeed(positions, position_sigma);
+  const bool dynamic = fit ? fit->speed > config_.static_max_speed && fit->speed > config_.dynamic_min_sigmas * fit->sigma
+                           : track.dynamic_guess;
   track.model = dynamic ? TrackModel::kDynamic : TrackModel::kStatic;
   if (!dynamic) newBlock(track.landmark, fromBlock(frames_.back().pose->data()) * track.observations.at(frame).b);
 }

@@ -1,0 +1,200 @@
+// The backend node without a network: the frame joiner, the offline driver (an LCM log with
+// ODOMETRY + ASSOCIATIONS in, SLOT_STATE out) and its command line.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+
+#include "backend/frame_joiner.hpp"
+#include "backend_scene.hpp"
+#include "dlslot/associations_t.hpp"
+#include "dlslot/convert.hpp"
+#include "dlslot/odometry_t.hpp"
+#include "dlslot/slot_state_t.hpp"
+#include "process_harness.hpp"
+
+using namespace dlslot;
+using namespace dlslot::backend;
+using namespace dlslot::backend::test;
+using dlslot::test::bin;
+using dlslot::test::ChildProcess;
+using dlslot::test::config;
+using dlslot::test::decodeAll;
+using dlslot::test::readLog;
+using dlslot::test::scratchDir;
+
+TEST(BackendFrameJoiner, JoinsByFrameAndTimesOut) {
+  FrameJoiner<int, std::string> j(1.0);
+  EXPECT_TRUE(j.addA(0, 10, 0.0));
+  EXPECT_TRUE(j.release(0.5).empty());  // waiting for B
+  EXPECT_TRUE(j.addB(0, "zero", 0.6));
+  auto out = j.release(0.6);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].frame, 0);
+  EXPECT_EQ(*out[0].a, 10);
+  EXPECT_EQ(*out[0].b, "zero");
+  // Frame 1 never gets its B: released after the timeout with B missing.
+  j.addA(1, 11, 1.0);
+  EXPECT_TRUE(j.release(1.9).empty());
+  out = j.release(2.0);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_FALSE(out[0].b.has_value());
+  // A late B for a released frame is refused.
+  EXPECT_FALSE(j.addB(1, "late", 2.1));
+  // Frame 2 lacks A, frame 3 is complete: 2 goes first, without waiting for its timeout.
+  j.addB(2, "two", 3.0);
+  j.addA(3, 13, 3.0);
+  j.addB(3, "three", 3.0);
+  out = j.release(3.0);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].frame, 2);
+  EXPECT_FALSE(out[0].a.has_value());
+  EXPECT_EQ(out[1].frame, 3);
+  j.addA(5, 15, 4.0);
+  EXPECT_EQ(j.flush().size(), 1u);
+  EXPECT_EQ(j.pending(), 0u);
+}
+
+namespace {
+
+// Writes a scene's inputs as the odometry and the tracker would publish them.
+void writeLog(const std::string& path, const std::vector<BackendInput>& inputs) {
+  lcm::LogFile log(path, "w");
+  ASSERT_TRUE(log.good());
+  int64_t n = 0;
+  auto write = [&](const std::string& channel, const auto& msg, int64_t utime) {
+    std::vector<uint8_t> buf(msg.getEncodedSize());
+    msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
+    lcm::LogEvent ev;
+    ev.eventnum = n++;
+    ev.timestamp = utime;
+    ev.channel = channel;
+    ev.datalen = static_cast<int32_t>(buf.size());
+    ev.data = buf.data();
+    ASSERT_EQ(log.writeEvent(&ev), 0);
+  };
+  for (const BackendInput& in : inputs) {
+    if (in.odometry) {
+      odometry_t o{};
+      o.utime = in.utime;
+      o.frame = in.frame;
+      o.status = in.frame == 0 ? odometry_t::STATUS_FIRST_FRAME : odometry_t::STATUS_OK;
+      o.pose = toMsg(in.odometry->pose);
+      o.delta = toMsg(in.odometry->delta);
+      toMsg(Matrix6d(Matrix6d::Identity() * 1e-4), o.covariance);
+      write("ODOMETRY", o, in.utime);
+    }
+    if (!in.associations_missing) {
+      associations_t a{};
+      a.utime = in.utime;
+      a.frame = in.frame;
+      a.ego_pose = toMsg(in.odometry ? in.odometry->pose : Pose::Identity());
+      a.ego_pose_source = "odometry";
+      for (const ObservationInput& obs : in.observations) {
+        association_t as{};
+        as.detection_index = static_cast<int32_t>(a.associations.size());
+        as.track_id = obs.track_id;
+        as.initialized = obs.initialized;
+        as.box_lidar = toMsg(obs.box);
+        as.box_world = toMsg(obs.box);
+        as.is_dynamic = obs.dynamic_guess;
+        a.associations.push_back(as);
+      }
+      // A malformed box (NaN size) is skipped and counted, never fatal.
+      association_t bad{};
+      bad.track_id = 999;
+      bad.box_lidar.size[0] = std::nan("");
+      a.associations.push_back(bad);
+      a.num_associations = static_cast<int32_t>(a.associations.size());
+      write("ASSOCIATIONS", a, in.utime + 1);
+    }
+  }
+}
+
+SimScene replayScene() {
+  SimScene s;
+  s.ego = constantTwist(Pose::Identity(), 10.0, 0.05);
+  s.odometry_noise << 0.02, 0.02, 0.01, 0.002, 0.002, 0.003;
+  s.box_noise << 0.1, 0.1, 0.05;
+  SimObject parked, moving;
+  parked.id = 1;
+  parked.pose = [](double) { return planarPose(20, 6, 0.2); };
+  moving.id = 2;
+  moving.pose = constantTwist(planarPose(10, -3.5, 0), 12.0, 0.05);
+  s.objects = {parked, moving};
+  s.frames_without_odometry = {7};
+  s.frames_without_associations = {9};
+  return s;
+}
+
+}  // namespace
+
+TEST(BackendNode, OfflineReplayWritesSlotState) {
+  const std::string dir = scratchDir();
+  const SimScene scene = replayScene();
+  const auto inputs = scene.generate(25);
+  writeLog(dir + "/in.lcmlog", inputs);
+  for (const std::string mode : {"slot", "two-stage", "odometry-only"}) {
+    const std::string out_path = dir + "/out-" + mode + ".lcmlog";
+    ChildProcess p({bin("dlslot-backend"), "--config", config(), "--offline", dir + "/in.lcmlog", "--out", out_path,
+                    "--mode", mode},
+                   dir + "/backend-" + mode + ".txt");
+    ASSERT_EQ(p.wait(120), 0) << p.output();
+    EXPECT_NE(p.output().find("25 frames, 1 without odometry, 1 without associations"), std::string::npos) << p.output();
+    const auto states = decodeAll<slot_state_t>(readLog(out_path)["SLOT_STATE"]);
+    ASSERT_EQ(states.size(), 25u);
+    for (size_t t = 0; t < states.size(); ++t) {
+      const slot_state_t& s = states[t];
+      EXPECT_EQ(s.frame, static_cast<int>(t));
+      EXPECT_EQ(s.utime, inputs[t].utime);
+      EXPECT_EQ(s.mode, mode);
+      EXPECT_EQ(s.odometry_missing, t == 7);
+      EXPECT_EQ(s.associations_missing, t == 9);
+      EXPECT_EQ(s.has_smoothed, t >= 9);  // window of 10
+      if (s.has_smoothed) {
+        EXPECT_EQ(s.smoothed_frame, static_cast<int>(t) - 9);
+      }
+      std::vector<std::string> stages;
+      for (const auto& st : s.timings) stages.push_back(st.name);
+      EXPECT_NE(std::find(stages.begin(), stages.end(), "solve"), stages.end());
+      EXPECT_NE(std::find(stages.begin(), stages.end(), "marginalize"), stages.end());
+      EXPECT_NE(std::find(stages.begin(), stages.end(), "total"), stages.end());
+    }
+    const slot_state_t& last = states.back();
+    EXPECT_LT((fromMsg(last.ego_pose).translation() - scene.egoTruth(24).translation()).norm(), 1.0);
+    if (mode == "odometry-only") {
+      EXPECT_EQ(last.num_tracks, 0);
+      continue;
+    }
+    ASSERT_EQ(last.num_tracks, 2);
+    for (const track_t& tr : last.tracks) {
+      EXPECT_EQ(tr.is_dynamic, tr.id == 2) << tr.id;
+      EXPECT_EQ(tr.age, 24);
+      EXPECT_EQ(tr.type, "Car");
+      if (tr.id == 2) {
+        EXPECT_NEAR(std::hypot(tr.velocity[0], tr.velocity[1]), 12.0, 1.0);
+      }
+      if (mode == "slot") {
+        EXPECT_GT(tr.covariance[0], 0.0);
+      }
+    }
+    if (mode == "slot") {
+      EXPECT_GT(last.ego_covariance[0], 0.0);
+      EXPECT_GT(last.iterations, 0);
+      EXPECT_LE(last.final_cost, last.initial_cost);
+    }
+  }
+}
+
+TEST(BackendNode, CommandLineErrors) {
+  const std::string dir = scratchDir();
+  ChildProcess bad_mode({bin("dlslot-backend"), "--config", config(), "--mode", "joint", "--check-config"}, dir + "/a.txt");
+  EXPECT_EQ(bad_mode.wait(30), 2);
+  EXPECT_NE(bad_mode.output().find("joint"), std::string::npos);
+  ChildProcess out_only({bin("dlslot-backend"), "--config", config(), "--out", dir + "/x.lcmlog"}, dir + "/b.txt");
+  EXPECT_EQ(out_only.wait(30), 2);
+  ChildProcess missing({bin("dlslot-backend"), "--config", config(), "--offline", dir + "/none.lcmlog"}, dir + "/c.txt");
+  EXPECT_NE(missing.wait(30), 0);
+  EXPECT_NE(missing.output().find("none.lcmlog"), std::string::npos);
+  ChildProcess ok({bin("dlslot-backend"), "--config", config(), "--check-config"}, dir + "/d.txt");
+  EXPECT_EQ(ok.wait(30), 0) << ok.output();
+}

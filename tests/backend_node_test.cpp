@@ -6,9 +6,8 @@
 
 #include "backend/frame_joiner.hpp"
 #include "backend_scene.hpp"
-#include "dlslot/associations_t.hpp"
+#include "backend_test_messages.hpp"
 #include "dlslot/convert.hpp"
-#include "dlslot/odometry_t.hpp"
 #include "dlslot/slot_state_t.hpp"
 #include "process_harness.hpp"
 
@@ -73,40 +72,8 @@ void writeLog(const std::string& path, const std::vector<BackendInput>& inputs) 
     ASSERT_EQ(log.writeEvent(&ev), 0);
   };
   for (const BackendInput& in : inputs) {
-    if (in.odometry) {
-      odometry_t o{};
-      o.utime = in.utime;
-      o.frame = in.frame;
-      o.status = in.frame == 0 ? odometry_t::STATUS_FIRST_FRAME : odometry_t::STATUS_OK;
-      o.pose = toMsg(in.odometry->pose);
-      o.delta = toMsg(in.odometry->delta);
-      toMsg(Matrix6d(Matrix6d::Identity() * 1e-4), o.covariance);
-      write("ODOMETRY", o, in.utime);
-    }
-    if (!in.associations_missing) {
-      associations_t a{};
-      a.utime = in.utime;
-      a.frame = in.frame;
-      a.ego_pose = toMsg(in.odometry ? in.odometry->pose : Pose::Identity());
-      a.ego_pose_source = "odometry";
-      for (const ObservationInput& obs : in.observations) {
-        association_t as{};
-        as.detection_index = static_cast<int32_t>(a.associations.size());
-        as.track_id = obs.track_id;
-        as.initialized = obs.initialized;
-        as.box_lidar = toMsg(obs.box);
-        as.box_world = toMsg(obs.box);
-        as.is_dynamic = obs.dynamic_guess;
-        a.associations.push_back(as);
-      }
-      // A malformed box (NaN size) is skipped and counted, never fatal.
-      association_t bad{};
-      bad.track_id = 999;
-      bad.box_lidar.size[0] = std::nan("");
-      a.associations.push_back(bad);
-      a.num_associations = static_cast<int32_t>(a.associations.size());
-      write("ASSOCIATIONS", a, in.utime + 1);
-    }
+    if (in.odometry) write("ODOMETRY", odometryMsg(in), in.utime);
+    if (!in.associations_missing) write("ASSOCIATIONS", associationsMsg(in), in.utime + 1);
   }
 }
 

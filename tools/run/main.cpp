@@ -133,12 +133,12 @@ int runPipeline(int argc, char** argv) {
 
   std::map<std::string, process_status_t> health;
   int slot_frames = 0, slot_last = -1;
-  auto last_progress = Node::Clock::now();
+  auto last_progress = Node::Clock::now(), last_slot_time = last_progress;
   node.subscribe<process_status_t>("PROCESS_STATUS", [&](const process_status_t& s) { health[s.name] = s; });
   node.subscribeFrames<slot_state_t>("SLOT_STATE", [&](const slot_state_t& s) {
     ++slot_frames;
     slot_last = s.frame;
-    last_progress = Node::Clock::now();
+    last_progress = last_slot_time = Node::Clock::now();
   });
   auto failIfDead = [&](const std::string& except) {
     while (auto e = sup.reap())
@@ -172,6 +172,7 @@ int runPipeline(int argc, char** argv) {
   else
     play.insert(play.end(), {"--lockstep", "SLOT_STATE"});
   sup.start("player", args(bin + "/dlslot-player", play), logs + "/player.log");
+  const auto play_start = Node::Clock::now();
   ProgressLine progress("run " + (scenario.empty() ? sequence : scenario) + " [" + mode + "]", last_frame + 1);
   last_progress = Node::Clock::now();
   auto healthText = [&] {
@@ -217,7 +218,10 @@ int runPipeline(int argc, char** argv) {
   }
   node.spinUntil([] { return false; }, 0.3);
   sup.stop("lcm-logger");
-  std::cerr << "SLOT_STATE for " << slot_frames << " of " << last_frame + 1 << " frames\n";
+  // The pipeline rate: from the player's start (less its start-up delay) to the last SLOT_STATE.
+  const double play_s = std::chrono::duration<double>(last_slot_time - play_start).count() - 0.2;
+  std::fprintf(stderr, "SLOT_STATE for %d of %d frames; pipeline rate %.2f frames/s (%s)\n", slot_frames,
+               last_frame + 1, play_s > 0 ? slot_frames / play_s : 0.0, speed > 0 ? "rate mode" : "lockstep");
   if (slot_frames != last_frame + 1) std::cerr << "warning: frames are missing from SLOT_STATE\n";
 
   // 6. Evaluate and export.

@@ -6,80 +6,20 @@
 #include <memory>
 #include <stdexcept>
 
+#include "lane_motion.hpp"
 #include "object_shape.hpp"
+#include "parking.hpp"
 #include "rng.hpp"
 
 namespace dlslot::sim {
 namespace {
 
-constexpr double kSubstep = 0.01;  // s, integration step
 const Eigen::Vector3d kEgoSize(4.6, 1.9, 1.6);
-
-// Target speed over time: knots joined by smoothsteps, so accelerations are continuous.
-class SpeedProfile {
- public:
-  explicit SpeedProfile(std::vector<std::pair<double, double>> knots) : k_(std::move(knots)) {}
-  double speed(double t) const { return eval(t, false); }
-  double rate(double t) const { return eval(t, true); }
-
- private:
-  double eval(double t, bool derivative) const {
-    if (k_.empty()) return 0.0;
-    if (t <= k_.front().first) return derivative ? 0.0 : k_.front().second;
-    for (size_t i = 1; i < k_.size(); ++i) {
-      if (t >= k_[i].first) continue;
-      const double T = k_[i].first - k_[i - 1].first, dv = k_[i].second - k_[i - 1].second;
-      const double u = (t - k_[i - 1].first) / T;
-      return derivative ? dv * 6 * u * (1 - u) / T : k_[i - 1].second + dv * u * u * (3 - 2 * u);
-    }
-    return derivative ? 0.0 : k_.back().second;
-  }
-  std::vector<std::pair<double, double>> k_;
-};
-
-// Following behaviour (IDM interaction term): a = a_max (1 - (s*/gap)^2), s* = s0 + v T + v dv / (2 sqrt(a b)).
-struct Following {
-  double a_max, b, s0, T;
-};
-Following followingOf(const std::string& type) {
-  if (type == "Pedestrian") return {0.8, 1.0, 0.6, 0.6};
-  if (type == "Cyclist") return {1.0, 1.5, 1.0, 0.8};
-  return {1.5, 2.0, 2.0, 0.9};
-}
-
-struct Mover {
-  int agent = -1;  // -1: the ego
-  std::shared_ptr<const Path> path;
-  std::string lane;  // movers on the same lane keep their distance
-  double half_length = 0, s0 = 0, v0 = 0;
-  SpeedProfile profile{{}};
-  Following follow{};
-  bool obeys_signals = true;  // pedestrians cross on their own schedule
-  std::vector<std::pair<double, const SignalSpec*>> stops;  // stop positions before signalled junctions
-};
 
 std::string pathKey(const PathSpec& p) {
   if (p.crossing_s_m) return "crossing:" + p.road + ":" + std::to_string(*p.crossing_s_m);
   if (p.route) return "";  // a route is its own lane (a unique key is given below)
   return "road:" + p.road + ":" + std::to_string(p.lane);
-}
-
-// Where signals stop this path: just before it enters a junction disk along the signal's axis.
-std::vector<std::pair<double, const SignalSpec*>> stopsOn(const Path& path, const Scenario& sc) {
-  std::vector<std::pair<double, const SignalSpec*>> out;
-  for (const SignalSpec& sig : sc.signals) {
-    const auto entry = path.entersDisk(sig.at, sig.radius_m);
-    if (!entry || *entry <= 0) continue;
-    if (std::abs(std::cos(path.at(*entry).heading - sig.axis)) < std::cos(M_PI / 4)) continue;
-    out.emplace_back(*entry - 0.5, &sig);
-  }
-  return out;
-}
-
-bool isRed(const SignalSpec& sig, double t) {
-  for (const Interval& r : sig.red)
-    if (t >= r.lo && t < r.hi) return true;
-  return false;
 }
 
 // Cruise speed with random changes and perhaps one stop, as profile knots.
@@ -128,73 +68,6 @@ std::string pickClass(const std::map<std::string, double>& weights, Rng& rng) {
     u -= kv.second;
   }
   return weights.rbegin()->first;
-}
-
-// Arc length and speed of every mover at every frame.
-struct Trace {
-  std::vector<std::vector<double>> s, v;  // [mover][frame]
-};
-
-Trace simulate(const std::vector<Mover>& movers, const std::vector<bool>& alive, const Scenario& sc) {
-  const size_t n = movers.size();
-  Trace tr;
-  tr.s.assign(n, std::vector<double>(sc.frames));
-  tr.v.assign(n, std::vector<double>(sc.frames));
-  std::vector<double> s(n), v(n);
-  for (size_t i = 0; i < n; ++i) {
-    s[i] = movers[i].s0;
-    v[i] = movers[i].v0;
-  }
-  std::map<std::string, std::vector<size_t>> lanes;
-  for (size_t i = 0; i < n; ++i)
-    if (alive[i]) lanes[movers[i].lane].push_back(i);
-  const int substeps = std::max(1, static_cast<int>(std::lround(sc.frame_period_s / kSubstep)));
-  const double dt = sc.frame_period_s / substeps;
-  std::vector<double> a(n);
-  for (int f = 0; f < sc.frames; ++f) {
-    for (size_t i = 0; i < n; ++i) {
-      tr.s[i][f] = s[i];
-      tr.v[i][f] = v[i];
-    }
-    if (f + 1 == sc.frames) break;
-    for (int k = 0; k < substeps; ++k) {
-      const double t = f * sc.frame_period_s + k * dt;
-      for (size_t i = 0; i < n; ++i) {
-        if (!alive[i]) continue;
-        const Mover& m = movers[i];
-        const double front = s[i] + m.half_length;
-        // Nearest obstacle ahead: a mover on the same lane, a red light it can still stop for, the path's end.
-        double gap = m.path->length() - front, lead_v = 0;
-        for (size_t j : lanes[m.lane]) {
-          if (j == i || s[j] <= s[i]) continue;
-          const double g = s[j] - movers[j].half_length - front;
-          if (g < gap) {
-            gap = g;
-            lead_v = v[j];
-          }
-        }
-        if (m.obeys_signals)
-          for (const auto& [stop, sig] : m.stops) {
-            const double g = stop - front;
-            if (g > 0 && g < gap && isRed(*sig, t) && v[i] * v[i] / (2 * g) < 3.5) {
-              gap = g;
-              lead_v = 0;
-            }
-          }
-        const Following& fo = m.follow;
-        const double track = std::clamp(m.profile.rate(t) + (m.profile.speed(t) - v[i]) / 0.8, -6.0, 3.0);
-        const double s_star = fo.s0 + std::max(0.0, v[i] * fo.T + v[i] * (v[i] - lead_v) / (2 * std::sqrt(fo.a_max * fo.b)));
-        const double interact = gap > 0.05 ? fo.a_max * (1 - (s_star / gap) * (s_star / gap)) : -9.0;
-        a[i] = std::max(-9.0, std::min(track, interact));
-      }
-      for (size_t i = 0; i < n; ++i) {
-        if (!alive[i]) continue;
-        v[i] = std::max(0.0, v[i] + a[i] * dt);
-        s[i] += v[i] * dt;
-      }
-    }
-  }
-  return tr;
 }
 
 Solid footprintBox(const Eigen::Vector2d& xy, double heading, const Eigen::Vector3d& size, const Ground& ground) {
@@ -313,41 +186,12 @@ Motion simulateMotion(const Scenario& sc, const World& world) {
   }
   const size_t num_moving = agents.size();
 
-  // Parked vehicles along parking strips, clear of lanes, junctions, structures and each other.
+  // Parked vehicles, with their footprints for the overlap checks.
+  for (Agent& ag : parkVehicles(sc, world)) agents.push_back(std::move(ag));
   std::vector<Solid> parked_boxes;
-  for (size_t r = 0; r < world.roads.size(); ++r) {
-    const Road& road = world.roads[r];
-    if (!road.spec->parking) continue;
-    const ParkingSpec& ps = *road.spec->parking;
-    Rng rng(streamKey({sc.seed, 4, r}));
-    for (int side : {-1, 1}) {
-      for (double s = rng.uniform(0, ps.spacing_m.hi); s < road.centre.length();
-           s += rng.uniform(ps.spacing_m.lo, ps.spacing_m.hi)) {
-        if (!rng.chance(ps.fill)) continue;
-        Agent ag;
-        ag.type = rng.chance(0.85) ? "Car" : "Van";
-        ag.size = sampleSize(ag.type, rng);
-        ag.parts = objectParts(ag.type, ag.size, static_cast<float>(rng.uniform(0.08, 0.5)));
-        ag.parked = true;
-        const Path::Sample at = road.centre.at(s);
-        const Eigen::Vector2d xy = at.p + side * ps.offset_m * Eigen::Vector2d(-std::sin(at.heading), std::cos(at.heading));
-        // Parallel parkers face the traffic of their side; stall parkers face in or out.
-        double heading = at.heading + (side > 0 ? M_PI : 0.0);
-        if (ps.angle > 0) heading = at.heading + side * ps.angle + (rng.chance(0.5) ? M_PI : 0.0);
-        heading = wrapAngle(heading);
-        const Solid box = footprintBox(xy, heading, ag.size, ground);
-        bool free = world.keepsOffRoads(box, &road, 1.5);
-        for (const Solid& o : parked_boxes) free = free && !overlaps(box, o, 0.3);
-        const Eigen::Vector2d ext = Eigen::Vector2d::Constant(box.radiusXY() + 0.5);
-        for (int i : world.grid->near(xy - ext, xy + ext)) free = free && !overlaps(box, world.grid->solids()[i], 0.3);
-        if (!free) continue;
-        parked_boxes.push_back(box);
-        ag.xy.assign(sc.frames, xy);
-        ag.heading.assign(sc.frames, heading);
-        ag.speed.assign(sc.frames, 0.0);
-        agents.push_back(ag);
-      }
-    }
+  for (size_t i = num_moving; i < agents.size(); ++i) {
+    const Box b = agentBox(agents[i], 0, ground);
+    parked_boxes.push_back(Solid::box(b.center, b.size, b.yaw, 0.0f));
   }
 
   // Simulate, find the first overlaps, drop the less important party, repeat. Importance: the ego,
@@ -360,7 +204,7 @@ Motion simulateMotion(const Scenario& sc, const World& world) {
   Motion out;
   Trace tr;
   for (;;) {
-    tr = simulate(movers, alive, sc);
+    tr = simulateLanes(movers, alive, sc.frames, sc.frame_period_s);
     // Boxes per frame: ego = index -1 in `who`.
     std::vector<int> remove;
     for (int f = 0; f < sc.frames && remove.empty(); ++f) {

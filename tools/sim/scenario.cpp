@@ -240,6 +240,7 @@ Scenario loadScenario(const std::string& path) {
     g.cfg.finish();
   }
   for (Section r : s.list("roads")) sc.roads.push_back(readRoad(r));
+  if (sc.roads.empty()) s.fail("roads", "expected at least one road (the world is built along the roads)");
   for (size_t i = 0; i < sc.roads.size(); ++i)
     for (size_t j = 0; j < i; ++j)
       if (sc.roads[i].name == sc.roads[j].name) s.fail("roads", "two roads named '" + sc.roads[i].name + "'");
@@ -319,10 +320,13 @@ std::string resolveScenario(const std::string& name_or_path, const std::string& 
   if (fs::is_regular_file(name_or_path)) return name_or_path;
   const fs::path named = fs::path(source_dir) / "config" / "scenarios" / (name_or_path + ".yaml");
   if (fs::is_regular_file(named)) return named.string();
-  std::string known;
+  std::vector<std::string> names;
   if (fs::is_directory(named.parent_path()))
     for (const auto& e : fs::directory_iterator(named.parent_path()))
-      if (e.path().extension() == ".yaml") known += (known.empty() ? "" : ", ") + e.path().stem().string();
+      if (e.path().extension() == ".yaml") names.push_back(e.path().stem().string());
+  std::sort(names.begin(), names.end());
+  std::string known;
+  for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
   throw ConfigError("scenario '" + name_or_path + "': no such file and no " + named.string() +
                     (known.empty() ? "" : " (known scenarios: " + known + ")"));
 }

@@ -50,6 +50,18 @@ TEST(OdometryRegistration, ScanToScanRecoversAKnownMotion) {
   EXPECT_GT(r.solution.min_eigenvalue, 1.0);
 }
 
+TEST(OdometryRegistration, FirstMotionOfAFastVehicleIsFound) {
+  // The second scan of a sequence taken 2.6 m further (26 m/s): no velocity to extrapolate yet.
+  const test::Scene street = test::street();
+  const FeatureConfig fc;
+  ScanReference previous;
+  previous.reset(extractFeatures(street.scan(Pose::Identity()), fc));
+  const Pose truth = test::planarPose(2.6, 0.0, 0.0);
+  const Registration r = registerFirstMotion(extractFeatures(street.scan(truth), fc), previous, ScanToScanConfig());
+  ASSERT_TRUE(r.solution.ok);
+  EXPECT_LT(translationError(r.solution.T_ref_cur, truth), 0.1);
+}
+
 TEST(OdometryRegistration, ScanToMapRecoversAKnownPose) {
   const test::Scene street = test::street();
   const FeatureConfig fc;

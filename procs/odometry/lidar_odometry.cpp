@@ -42,7 +42,7 @@ void LidarOdometry::reset() {
   map_.clear();
   reference_ = ScanReference();
   T_world_reference_ = T_world_last_ = velocity_ = Pose::Identity();
-  started_ = false;
+  started_ = moving_ = false;
 }
 
 void LidarOdometry::fallBack(Status status, const std::string& why, const Pose& prediction, OdometryResult& out) {
@@ -97,7 +97,8 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
   Registration s2s;
   s2s.solution.T_ref_cur = Pose::Identity();
   if (started_) {
-    s2s = registerScanToScan(features, reference_, T_world_reference_.inverse() * prediction, cfg_.scan_to_scan);
+    s2s = moving_ ? registerScanToScan(features, reference_, T_world_reference_.inverse() * prediction, cfg_.scan_to_scan)
+                  : registerFirstMotion(features, reference_, cfg_.scan_to_scan);
     out.timings.emplace_back("scan_to_scan", msSince(t));
     if (!s2s.solution.ok) {
       fallBack(Status::FallbackSolveFailed,
@@ -123,8 +124,8 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
     std::string failure;
     if (!s2m.solution.ok)
       failure = "scan-to-map failed (" + std::to_string(s2m.num_correspondences) + " correspondences)";
-    else if (correction.translation().norm() > cfg_.max_correction_m ||
-             angleOf(correction) > cfg_.max_correction_deg * M_PI / 180.0)
+    else if (moving_ && (correction.translation().norm() > cfg_.max_correction_m ||
+                         angleOf(correction) > cfg_.max_correction_deg * M_PI / 180.0))
       failure = "solution jumped " + std::to_string(correction.translation().norm()) + " m from the prediction";
     if (!failure.empty()) {
       out.timings.emplace_back("scan_to_map", msSince(t));
@@ -147,7 +148,10 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
 
   out.T_world_lidar = pose;
   out.delta = T_world_last_.inverse() * pose;
-  if (started_) velocity_ = out.delta;
+  if (started_) {
+    velocity_ = out.delta;
+    moving_ = true;
+  }
   T_world_last_ = T_world_reference_ = pose;
   reference_.reset(features);
   started_ = true;

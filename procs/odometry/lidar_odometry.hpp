@@ -61,6 +61,7 @@ class LidarOdometry {
   Pose T_world_last_ = Pose::Identity();       // the last published pose
   Pose velocity_ = Pose::Identity();           // the last delta: constant-velocity model
   bool started_ = false;
+  bool moving_ = false;                        // velocity_ comes from a registration
 };
 
 }  // namespace dlslot::odometry

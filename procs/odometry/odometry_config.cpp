@@ -56,7 +56,10 @@ void readScanToScan(ConfigSection s, ScanToScanConfig& c) {
   s.get("nearby_beams", c.nearby_beams);
   s.get("candidates", c.candidates);
   s.get("min_correspondences", c.min_correspondences);
+  s.get("first_motion_guesses_m", c.first_motion_guesses_m);
   s.finish();
+  if (c.first_motion_guesses_m.empty())
+    throw ConfigError(s.file() + ": " + s.path() + ".first_motion_guesses_m: expected at least one distance");
 }
 
 void readScanToMap(ConfigSection s, ScanToMapConfig& c) {

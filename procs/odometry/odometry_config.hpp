@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "dlslot/config.hpp"
 
@@ -48,6 +49,8 @@ struct ScanToScanConfig {
   int nearby_beams = 2;               // second/third match points come from beams this close
   int candidates = 10;                // ...among this many nearest previous points
   int min_correspondences = 30;
+  // Forward distances (m) the second scan of a sequence is registered from (no velocity yet).
+  std::vector<double> first_motion_guesses_m = {0.0, 1.0, 2.0, 3.0};
 };
 
 // Scan-to-map refinement against a local map (A-LOAM laserMapping).

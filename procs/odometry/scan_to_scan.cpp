@@ -98,4 +98,16 @@ Registration registerScanToScan(const ScanFeatures& current, const ScanReference
                              cfg.min_correspondences);
 }
 
+Registration registerFirstMotion(const ScanFeatures& current, const ScanReference& previous,
+                                 const ScanToScanConfig& cfg) {
+  Registration best;
+  for (double forward : cfg.first_motion_guesses_m) {
+    Pose guess = Pose::Identity();
+    guess.translation().x() = forward;
+    const Registration r = registerScanToScan(current, previous, guess, cfg);
+    if (r.solution.ok && (!best.solution.ok || r.solution.num_inliers > best.solution.num_inliers)) best = r;
+  }
+  return best;
+}
+
 }  // namespace dlslot::odometry

@@ -32,4 +32,10 @@ Matches matchScanToScan(const ScanFeatures& current, const ScanReference& previo
 Registration registerScanToScan(const ScanFeatures& current, const ScanReference& previous,
                                     const Pose& guess, const ScanToScanConfig& cfg);
 
+// The second scan of a sequence has no motion to extrapolate, yet the vehicle may already move
+// fast (a sequence starting on a highway): registration starts from each forward distance of
+// cfg.first_motion_guesses_m and keeps the solution with the most inlier correspondences.
+Registration registerFirstMotion(const ScanFeatures& current, const ScanReference& previous,
+                                 const ScanToScanConfig& cfg);
+
 }  // namespace dlslot::odometry

@@ -107,7 +107,11 @@ TEST(BackendNode, OfflineReplayWritesSlotState) {
                    dir + "/backend-" + mode + ".txt");
     ASSERT_EQ(p.wait(120), 0) << p.output();
     EXPECT_NE(p.output().find("25 frames, 1 without odometry, 1 without associations"), std::string::npos) << p.output();
-    const auto states = decodeAll<slot_state_t>(readLog(out_path)["SLOT_STATE"]);
+    auto events = readLog(out_path);
+    // The input run is copied, with this run's SLOT_STATE added.
+    EXPECT_EQ(events["ODOMETRY"].size(), 24u);
+    EXPECT_EQ(events["ASSOCIATIONS"].size(), 24u);
+    const auto states = decodeAll<slot_state_t>(events["SLOT_STATE"]);
     ASSERT_EQ(states.size(), 25u);
     for (size_t t = 0; t < states.size(); ++t) {
       const slot_state_t& s = states[t];

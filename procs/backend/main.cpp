@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <stdexcept>
 
 #include "backend/backend_messages.hpp"
@@ -83,14 +84,11 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
       joiner.addB(m.frame, AssociationsPart{m.utime, observationsFromMsg(m, &rejected)}, 0.0);
     }
   }
-  std::unique_ptr<lcm::LogFile> out;
-  if (!out_path.empty()) {
-    out = std::make_unique<lcm::LogFile>(out_path, "w");
-    if (!out->good()) throw std::runtime_error(out_path + ": cannot open LCM log for writing");
-  }
   SlidingWindow window(config);
   TimingStats total, solve, marginalize;
   int frames = 0, missing_odometry = 0, missing_associations = 0;
+  std::map<int, slot_state_t> states;
+  std::map<int, int> inputs_left;  // frame -> its input events not yet copied to the output
   for (const Joiner::Joined& j : joiner.flush()) {
     const BackendOutput result = window.process(toInput(j));
     ++frames;
@@ -99,17 +97,46 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
     total.add(result.stats.total_ms);
     solve.add(result.stats.solve_ms);
     marginalize.add(result.stats.marginalize_ms);
-    if (!out) continue;
-    const slot_state_t msg = toMsg(result, toString(config.mode));
-    std::vector<uint8_t> buf(msg.getEncodedSize());
-    msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
-    lcm::LogEvent ev;
-    ev.eventnum = frames - 1;
-    ev.timestamp = result.utime;
-    ev.channel = channels.slot_state;
-    ev.datalen = static_cast<int32_t>(buf.size());
-    ev.data = buf.data();
-    if (out->writeEvent(&ev) != 0) throw std::runtime_error(out_path + ": write failed");
+    states[j.frame] = toMsg(result, toString(config.mode));
+    inputs_left[j.frame] = (j.a ? 1 : 0) + (j.b ? 1 : 0);
+  }
+  if (!out_path.empty()) {
+    // The output is the input run with this SLOT_STATE instead of the recorded one (if any):
+    // every other event is copied in order, and a frame's SLOT_STATE follows its last input,
+    // so dlslot-eval can evaluate it like a live run.
+    lcm::LogFile out(out_path, "w");
+    if (!out.good()) throw std::runtime_error(out_path + ": cannot open LCM log for writing");
+    lcm::LogFile again(in_path, "r");
+    int64_t n = 0;
+    std::vector<uint8_t> buf;
+    auto write = [&](const lcm::LogEvent& ev) {
+      lcm::LogEvent copy = ev;
+      copy.eventnum = n++;
+      if (out.writeEvent(&copy) != 0) throw std::runtime_error(out_path + ": write failed");
+    };
+    while (const lcm::LogEvent* ev = again.readNextEvent()) {
+      if (ev->channel == channels.slot_state) continue;
+      write(*ev);
+      int frame = -1;
+      if (ev->channel == channels.odometry) {
+        odometry_t m;
+        if (m.decode(ev->data, 0, ev->datalen) >= 0) frame = m.frame;
+      } else if (ev->channel == channels.associations) {
+        associations_t m;
+        if (m.decode(ev->data, 0, ev->datalen) >= 0) frame = m.frame;
+      }
+      auto left = inputs_left.find(frame);
+      if (left == inputs_left.end() || --left->second > 0) continue;
+      const slot_state_t& msg = states.at(frame);
+      buf.resize(msg.getEncodedSize());
+      msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
+      lcm::LogEvent state;
+      state.timestamp = ev->timestamp;
+      state.channel = channels.slot_state;
+      state.datalen = static_cast<int32_t>(buf.size());
+      state.data = buf.data();
+      write(state);
+    }
   }
   std::printf("backend (%s): %d frames, %d without odometry, %d without associations, %d undecodable, %d bad boxes\n",
               toString(config.mode).c_str(), frames, missing_odometry, missing_associations, decode_errors, rejected);
@@ -166,7 +193,8 @@ int main(int argc, char** argv) {
     opts.addTo(cl);
     cl.option("--mode", &mode, "slot | two-stage | odometry-only (overrides backend.mode)");
     cl.option("--offline", &offline_in, "read ODOMETRY and ASSOCIATIONS from this LCM log instead of the network");
-    cl.option("--out", &offline_out, "with --offline: write SLOT_STATE events to this LCM log");
+    cl.option("--out", &offline_out,
+              "with --offline: write the input log with this run's SLOT_STATE (replacing any recorded one) here");
     if (!cl.parse(argc, argv)) return 0;
     if (!offline_out.empty() && offline_in.empty()) throw std::invalid_argument("--out needs --offline");
 

@@ -90,9 +90,9 @@ int runNode(const NodeOptions& node_opts, const Channels& channels, const Odomet
   auto releaseReady = [&] {
     for (JoinedScan& joined : joiner.release(secondsNow())) process(joined);
   };
-  // A frame at or before one already handled: the input restarted (a new run). Start over.
+  // A scan older than one already handled: the input restarted (a new run). Start over.
   auto restartIfRewound = [&](int frame) {
-    if (joiner.lastReleased() < 0 || frame > joiner.lastReleased()) return;
+    if (frame >= joiner.lastReleased()) return;
     status.warn("frame " + std::to_string(frame) + " after frame " + std::to_string(joiner.lastReleased()) +
                 ": input restarted, odometry reset");
     joiner.reset();
@@ -101,10 +101,11 @@ int runNode(const NodeOptions& node_opts, const Channels& channels, const Odomet
 
   node.subscribeFrames<point_cloud_t>(channels.scan, [&](const point_cloud_t& msg) {
     restartIfRewound(msg.frame);
-    joiner.addScan(msg.frame, msg.utime, fromMsg(msg), secondsNow());
+    if (!joiner.addScan(msg.frame, msg.utime, fromMsg(msg), secondsNow())) status.count("stale_messages");
     releaseReady();
   });
   node.subscribeFrames<detections_t>(channels.detections, [&](const detections_t& msg) {
+    if (msg.frame == 0) restartIfRewound(0);  // a restarted player may send DETECTIONS 0 first
     std::vector<Box> boxes;
     int rejected = 0;
     for (const box_t& b : msg.boxes) {

@@ -132,13 +132,20 @@ SimScene streetScene() {
   return s;
 }
 
+// The backend's settings with the odometry covariance the street scene simulates.
+BackendConfig streetConfig() {
+  BackendConfig c;
+  c.compute_covariance = false;
+  c.odometry_sigma << 0.02, 0.02, 0.01, 0.002, 0.002, 0.003;
+  return c;
+}
+
 }  // namespace
 
 TEST(BackendSlidingWindow, NonlinearCaseStaysCloseToBatch) {
   SimScene scene = streetScene();
   const std::vector<BackendInput> inputs = scene.generate(40);
-  BackendConfig c;
-  c.compute_covariance = false;
+  const BackendConfig c = streetConfig();
   BackendConfig b = c;
   b.window_size = 1000;
   SlidingWindow window(c), batch(b);
@@ -173,8 +180,7 @@ TEST(BackendSlidingWindow, FarOffSpuriousDetectionDoesNotPullTheEgoPose) {
     }
   ASSERT_GE(victim, 0);
   auto shiftAt25 = [&](const std::string& loss) {
-    BackendConfig c;
-    c.compute_covariance = false;
+    BackendConfig c = streetConfig();
     c.observation_loss = loss;
     SlidingWindow a(c), b(c);
     const std::vector<BackendInput> clean_head(clean.begin(), clean.begin() + 27);
@@ -254,8 +260,7 @@ TEST(BackendSlidingWindow, FrameWithoutOdometry) {
   scene.frames_without_odometry = {20};
   const auto inputs = scene.generate(30);
   for (Mode mode : {Mode::kSlot, Mode::kOdometryOnly}) {
-    BackendConfig c;
-    c.compute_covariance = false;
+    BackendConfig c = streetConfig();
     c.mode = mode;
     SlidingWindow window(c);
     const auto out = run(window, inputs);
@@ -343,9 +348,8 @@ TEST(BackendSlidingWindow, TwoStageAndOdometryOnlyKeepTheOdometryPoses) {
   const SimScene scene = streetScene();
   const auto inputs = scene.generate(25);
   for (Mode mode : {Mode::kTwoStage, Mode::kOdometryOnly}) {
-    BackendConfig c;
+    BackendConfig c = streetConfig();
     c.mode = mode;
-    c.compute_covariance = false;
     SlidingWindow window(c);
     const auto out = run(window, inputs);
     for (size_t t = 0; t < inputs.size(); ++t)
@@ -366,7 +370,9 @@ TEST(BackendSlidingWindow, TwoStageAndOdometryOnlyKeepTheOdometryPoses) {
 TEST(BackendSlidingWindow, CovariancesAreReported) {
   const SimScene scene = streetScene();
   const auto inputs = scene.generate(15);
-  SlidingWindow window{BackendConfig()};
+  BackendConfig c = streetConfig();
+  c.compute_covariance = true;
+  SlidingWindow window(c);
   const auto out = run(window, inputs);
   const BackendOutput& last = out.back();
   EXPECT_GT(last.ego_covariance(0, 0), 0.0);

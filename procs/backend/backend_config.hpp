@@ -22,7 +22,7 @@ struct BackendConfig {
 
   // Standard deviations [tx ty tz (m), rx ry rz (rad)] of each factor's residual; the
   // information matrix is diag(sigma)^-2 (the Sigma of eq. 12).
-  Vector6 odometry_sigma = (Vector6() << 0.03, 0.03, 0.03, 0.003, 0.003, 0.003).finished();
+  Vector6 odometry_sigma = (Vector6() << 0.05, 0.05, 0.05, 0.0005, 0.0005, 0.0005).finished();
   Vector6 observation_sigma = (Vector6() << 0.25, 0.15, 0.15, 0.05, 0.05, 0.1).finished();
   Vector6 landmark_sigma = (Vector6() << 0.15, 0.1, 0.1, 0.05, 0.05, 0.05).finished();
   Vector6 pose_change_sigma = (Vector6() << 0.02, 0.02, 0.02, 0.005, 0.005, 0.005).finished();

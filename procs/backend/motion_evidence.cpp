@@ -7,22 +7,26 @@ namespace dlslot::backend {
 std::optional<SpeedFit> fitSpeed(const std::vector<TimedPosition>& positions, double position_sigma) {
   if (positions.size() < 2) return std::nullopt;
   double t_mean = 0;
-  Eigen::Vector2d p_mean = Eigen::Vector2d::Zero();
+  Eigen::Vector3d p_mean = Eigen::Vector3d::Zero();
   for (const auto& tp : positions) {
     t_mean += tp.t;
-    p_mean += tp.p.head<2>();
+    p_mean += tp.p;
   }
   t_mean /= positions.size();
   p_mean /= positions.size();
   double stt = 0;
-  Eigen::Vector2d stp = Eigen::Vector2d::Zero();
+  Eigen::Vector3d stp = Eigen::Vector3d::Zero();
   for (const auto& tp : positions) {
     stt += (tp.t - t_mean) * (tp.t - t_mean);
-    stp += (tp.t - t_mean) * (tp.p.head<2>() - p_mean);
+    stp += (tp.t - t_mean) * (tp.p - p_mean);
   }
   if (stt < 1e-12) return std::nullopt;
+  SpeedFit fit;
+  fit.velocity = stp / stt;
+  fit.speed = fit.velocity.head<2>().norm();
   // Slope variance of a least-squares line: sigma^2 / sum (t - t_mean)^2.
-  return SpeedFit{(stp / stt).norm(), position_sigma / std::sqrt(stt)};
+  fit.sigma = position_sigma / std::sqrt(stt);
+  return fit;
 }
 
 bool leftLandmark(const std::vector<Eigen::Vector3d>& positions, const Eigen::Vector3d& landmark, double distance,

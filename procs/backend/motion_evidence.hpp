@@ -15,6 +15,7 @@ struct TimedPosition {
 };
 
 struct SpeedFit {
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // m/s, world frame
   double speed = 0;  // m/s, bird's-eye
   double sigma = 0;  // its standard deviation per axis for positions with noise position_sigma
 };

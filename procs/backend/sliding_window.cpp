@@ -142,16 +142,19 @@ void SlidingWindow::addObservations(const BackendInput& in) {
   }
 }
 
-void SlidingWindow::startTrack(Track& track, int frame) {
-  // Static or dynamic from the positions of the trajectory in the window (III-D); the tracker's
-  // guess only when the window has too little of it.
+std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track) const {
   std::vector<TimedPosition> positions;
   for (const auto& [f, obs] : track.observations) {
     const EgoFrame* ego = findFrame(f);
     if (ego) positions.push_back({1e-6 * static_cast<double>(ego->utime), fromBlock(ego->pose->data()) * obs.b.translation()});
   }
-  const double position_sigma = 0.5 * (config_.observation_sigma[0] + config_.observation_sigma[1]);
-  const std::optional<SpeedFit> fit = fitSpeed(positions, position_sigma);
+  return fitSpeed(positions, 0.5 * (config_.observation_sigma[0] + config_.observation_sigma[1]));
+}
+
+void SlidingWindow::startTrack(Track& track, int frame) {
+  // Static or dynamic from the positions of the trajectory in the window (III-D); the tracker's
+  // guess only when the window has too little of it.
+  const std::optional<SpeedFit> fit = windowMotion(track);
   const bool dynamic = fit ? fit->speed > config_.static_max_speed && fit->speed > config_.dynamic_min_sigmas * fit->sigma
                            : track.dynamic_guess;
   track.model = dynamic ? TrackModel::kDynamic : TrackModel::kStatic;
@@ -312,7 +315,11 @@ void SlidingWindow::fillTracks(BackendOutput& out, ceres::Problem* problem) {
       const auto& [f_last, o_last] = *track.poses.rbegin();
       block = f_last == t ? o_last->data() : nullptr;
       e.pose = *predictedPose(track);
-      if (!track.changes.empty()) {
+      if (track.changes.size() < 2) {
+        // Not in O_cons yet (eq. 12: no constant-velocity factor smooths its pose change): the
+        // velocity of the trajectory's observed positions in the window says more.
+        if (const auto fit = windowMotion(track)) e.velocity = fit->velocity;
+      } else {
         // Velocities from the latest pose change c_f^{f+1} = o_f^-1 o_{f+1} over its time.
         const auto& [f, c_block] = *track.changes.rbegin();
         const EgoFrame *a = findFrame(f), *b = findFrame(f + 1);

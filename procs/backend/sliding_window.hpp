@@ -21,6 +21,7 @@
 #include "backend/backend_types.hpp"
 #include "backend/factor.hpp"
 #include "backend/marginalizer.hpp"
+#include "backend/motion_evidence.hpp"
 #include "backend/pose_manifold.hpp"
 
 namespace ceres {
@@ -76,6 +77,8 @@ class SlidingWindow {
   void addEgoFrame(const BackendInput& in);
   void addObservations(const BackendInput& in);
   void startTrack(Track& track, int frame);
+  // The least-squares motion of the track's observed positions in the window (world frame).
+  std::optional<SpeedFit> windowMotion(const Track& track) const;
   void addTrackObservation(Track& track, int frame);
   void extendChain(Track& track, int frame, const Pose& o);
   int switchMovingLandmarks();

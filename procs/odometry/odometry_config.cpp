@@ -58,8 +58,9 @@ void readScanToScan(ConfigSection s, ScanToScanConfig& c) {
   s.get("min_correspondences", c.min_correspondences);
   s.get("first_motion_guesses_m", c.first_motion_guesses_m);
   s.finish();
-  if (c.first_motion_guesses_m.empty())
-    throw ConfigError(s.file() + ": " + s.path() + ".first_motion_guesses_m: expected at least one distance");
+  if (c.first_motion_guesses_m.empty() || c.candidates < 3)
+    throw ConfigError(s.file() + ": " + s.path() +
+                      ": expected candidates >= 3 and at least one distance in first_motion_guesses_m");
 }
 
 void readScanToMap(ConfigSection s, ScanToMapConfig& c) {

@@ -48,10 +48,9 @@ Matches matchScanToScan(const ScanFeatures& current, const ScanReference& previo
   Matches m;
   Candidates c;
   const double max_d2 = cfg.max_match_distance_m * cfg.max_match_distance_m;
-  const Pose T = T_prev_cur;
   auto moved = [&](const pcl::PointXYZI& p) {
     pcl::PointXYZI q = p;
-    q.getVector3fMap() = (T * vec(p)).cast<float>();
+    q.getVector3fMap() = (T_prev_cur * vec(p)).cast<float>();
     return q;
   };
 

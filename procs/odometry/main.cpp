@@ -140,7 +140,7 @@ int run(int argc, char** argv) {
   cl.flag("--offline", &run_offline, "no LCM: read --kitti/--sequence, write --out");
   cl.option("--kitti", &offline.root, "offline: KITTI root (holding training/ or sequences/)");
   cl.option("--sequence", &offline.sequence, "offline: sequence name, e.g. 0000 or 07");
-  cl.repeated("--detections", &offline.detections, "offline: detection file or directory (repeatable)");
+  cl.repeated("--detections", &offline.detections, "offline: detection file or directory");
   cl.option("--out", &offline.out, "offline: trajectory file to write");
   cl.flag("--quiet", &offline.quiet, "offline: no progress line");
   node_opts.addTo(cl);

@@ -74,7 +74,8 @@ TEST(SimScan, SpatialIndexFindsTheNearestSolidLikeBruteForce) {
   int hits = 0;
   for (int k = 0; k < 20000; ++k) {
     const double az = rng.uniform(-M_PI, M_PI), el = rng.uniform(-0.45, 0.3);
-    const Eigen::Vector3d d = T.linear() * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+    const Eigen::Vector3d d =
+        T.linear() * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
     const Eigen::Vector3d o = T.translation() + Eigen::Vector3d(rng.uniform(-20, 20), rng.uniform(-3, 3), 0);
     double s_grid = 0;
     const int i_grid = w.grid->cast(o, d, 120.0, s_grid, scratch);

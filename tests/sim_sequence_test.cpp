@@ -1,11 +1,11 @@
 // dlslot-sim writes what it simulated: the same seed gives the same bytes, and the KITTI files
 // read back through kitti::SequenceReader (the player's reader) give the generated ground truth.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <unistd.h>
 
 #include "dlslot/kitti.hpp"
 #include "sim/oxts.hpp"
@@ -116,7 +116,8 @@ TEST(SimSequence, ReaderGetsBackTheGeneratedGroundTruth) {
     const Pose T_lidar_map = fd.input.T_map_lidar.inverse();
     for (const Box& b : f.labels) {
       double best = 1e9;
-      for (const Box& o : fd.input.object_boxes) best = std::min(best, (o.transformed(T_lidar_map).center - b.center).norm());
+      for (const Box& o : fd.input.object_boxes)
+        best = std::min(best, (o.transformed(T_lidar_map).center - b.center).norm());
       EXPECT_LT(best, 1e-5);
     }
     size_t detections = 0;
@@ -141,7 +142,8 @@ TEST(SimSequence, OxtsRoundTripRecoversThePosesWithinAMillimetre) {
   double worst = 0, worst_angle = 0;
   for (size_t k = 0; k < poses.size(); ++k) {
     worst = std::max(worst, (from_oxts[k].translation() - poses[k].translation()).norm());
-    worst_angle = std::max(worst_angle, Eigen::AngleAxisd(from_oxts[k].linear().transpose() * poses[k].linear()).angle());
+    worst_angle =
+        std::max(worst_angle, Eigen::AngleAxisd(from_oxts[k].linear().transpose() * poses[k].linear()).angle());
   }
   EXPECT_LT(worst, 1e-3);
   EXPECT_LT(worst_angle, 1e-6);

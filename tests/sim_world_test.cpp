@@ -2,10 +2,10 @@
 // the file and key named; no two solids ever overlap; paths are smooth; the highway surrounds
 // the ego with cars at its speed.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
 #include "dlslot/config.hpp"
 #include "sim/simulation.hpp"
@@ -68,12 +68,12 @@ TEST(SimScenario, BadFilesNameTheFileAndTheKey) {
   const std::string unknown = errorOf(std::string(kMinimal) + "colour: red\n");
   EXPECT_NE(unknown.find("colour"), std::string::npos) << unknown;
   EXPECT_NE(unknown.find("unknown key"), std::string::npos) << unknown;
-  const std::string road = errorOf(std::string(kMinimal) +
-                                   "traffic:\n  - {road: side, lane: 1, classes: {Car: 1}, count: 1, speed_mps: [1, 2]}\n");
+  const std::string road = errorOf(
+      std::string(kMinimal) + "traffic:\n  - {road: side, lane: 1, classes: {Car: 1}, count: 1, speed_mps: [1, 2]}\n");
   EXPECT_NE(road.find("traffic[0].road"), std::string::npos) << road;
   EXPECT_NE(road.find("no road named 'side'"), std::string::npos) << road;
-  const std::string cls = errorOf(std::string(kMinimal) +
-                                  "traffic:\n  - {road: main, lane: 1, classes: {Tank: 1}, count: 1, speed_mps: [1, 2]}\n");
+  const std::string cls = errorOf(
+      std::string(kMinimal) + "traffic:\n  - {road: main, lane: 1, classes: {Tank: 1}, count: 1, speed_mps: [1, 2]}\n");
   EXPECT_NE(cls.find("unknown class 'Tank'"), std::string::npos) << cls;
   std::string no_lanes = kMinimal;
   no_lanes.replace(no_lanes.find("    lanes: [-1.75, 1.75]\n"), 25, "");

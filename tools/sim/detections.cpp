@@ -59,8 +59,8 @@ std::vector<bool> chooseGhosts(const World& world, const DetectorSpec& spec, uin
   std::vector<bool> ghosts(world.structures.size(), false);
   for (size_t i = 0; i < ghosts.size(); ++i) {
     const StructureKind k = world.structures[i].kind;
-    const bool slim = k == StructureKind::Pole || k == StructureKind::Sign || k == StructureKind::Tree ||
-                      k == StructureKind::Bush;
+    const bool slim =
+        k == StructureKind::Pole || k == StructureKind::Sign || k == StructureKind::Tree || k == StructureKind::Bush;
     ghosts[i] = slim && rng.chance(spec.ghost_fraction);
   }
   return ghosts;
@@ -74,7 +74,8 @@ std::vector<kitti::LabelRow> detect(int frame, const std::vector<DetectorTarget>
     const double p = spec.max_probability * (1.0 - std::exp(-M_LN2 * t.points / spec.points_for_half));
     if (!rng.chance(p)) continue;
     const Box b = noisy(t.box, spec, rng);
-    rows.push_back(detectionRow(frame, t.track_id, b, sigmoid(rng.normal(scoreLogit(t.box.type, t.points), 0.8)), calib));
+    rows.push_back(
+        detectionRow(frame, t.track_id, b, sigmoid(rng.normal(scoreLogit(t.box.type, t.points), 0.8)), calib));
   }
   // Points per structure this frame, and the static points near enough to fool the detector.
   std::vector<int> hits(world.structures.size(), 0);
@@ -96,7 +97,10 @@ std::vector<kitti::LabelRow> detect(int frame, const std::vector<DetectorTarget>
     const size_t i = clutter[static_cast<size_t>(rng.uniform() * clutter.size())];
     const Eigen::Vector3d p_map = T_map_lidar * scan.points.col(i).head<3>().cast<double>();
     const double u = rng.uniform();
-    const Box b = phantom(u < 0.6 ? "Car" : u < 0.85 ? "Pedestrian" : "Cyclist", p_map.head<2>(), world, T_map_lidar, rng);
+    const Box b = phantom(u < 0.6    ? "Car"
+                          : u < 0.85 ? "Pedestrian"
+                                     : "Cyclist",
+                          p_map.head<2>(), world, T_map_lidar, rng);
     rows.push_back(detectionRow(frame, -1, b, sigmoid(rng.normal(-1.0, 0.8)), calib));
   }
   return rows;

@@ -34,9 +34,9 @@ class SolidGrid {
   double cell_;
   Eigen::Vector2d origin_;
   int nx_ = 0, ny_ = 0;
-  std::vector<uint32_t> begin_;    // CSR: solids of cell c are index_[begin_[c] .. begin_[c+1])
+  std::vector<uint32_t> begin_;  // CSR: solids of cell c are index_[begin_[c] .. begin_[c+1])
   std::vector<uint32_t> index_;
-  std::vector<float> top_;         // highest solid top per cell
+  std::vector<float> top_;  // highest solid top per cell
 };
 
 }  // namespace dlslot::sim

@@ -38,8 +38,8 @@ std::optional<ImageBox> projectToImage(const Box& box, const kitti::Calib& calib
   }
   const double area = (r - l) * (bo - t);
   ImageBox ib;
-  ib.bbox << std::clamp(l, 0.0, kImageWidth - 1), std::clamp(t, 0.0, kImageHeight - 1), std::clamp(r, 0.0, kImageWidth - 1),
-      std::clamp(bo, 0.0, kImageHeight - 1);
+  ib.bbox << std::clamp(l, 0.0, kImageWidth - 1), std::clamp(t, 0.0, kImageHeight - 1),
+      std::clamp(r, 0.0, kImageWidth - 1), std::clamp(bo, 0.0, kImageHeight - 1);
   const double clipped = (ib.bbox[2] - ib.bbox[0]) * (ib.bbox[3] - ib.bbox[1]);
   if (clipped <= 0) return std::nullopt;
   ib.truncated = area > 0 ? std::clamp(1.0 - clipped / area, 0.0, 1.0) : 0.0;

@@ -46,7 +46,8 @@ std::vector<std::pair<double, const SignalSpec*>> stopsOn(const Path& path, cons
   return out;
 }
 
-Trace simulateLanes(const std::vector<Mover>& movers, const std::vector<bool>& alive, int frames, double frame_period_s) {
+Trace simulateLanes(const std::vector<Mover>& movers, const std::vector<bool>& alive, int frames,
+                    double frame_period_s) {
   const size_t n = movers.size();
   Trace tr;
   tr.s.assign(n, std::vector<double>(frames));
@@ -94,7 +95,8 @@ Trace simulateLanes(const std::vector<Mover>& movers, const std::vector<bool>& a
           }
         const Following& fo = m.follow;
         const double track = std::clamp(m.profile.rate(t) + (m.profile.speed(t) - v[i]) / 0.8, -6.0, 3.0);
-        const double s_star = fo.s0 + std::max(0.0, v[i] * fo.T + v[i] * (v[i] - lead_v) / (2 * std::sqrt(fo.a_max * fo.b)));
+        const double s_star =
+            fo.s0 + std::max(0.0, v[i] * fo.T + v[i] * (v[i] - lead_v) / (2 * std::sqrt(fo.a_max * fo.b)));
         const double interact = gap > 0.05 ? fo.a_max * (1 - (s_star / gap) * (s_star / gap)) : -9.0;
         a[i] = std::max(-9.0, std::min(track, interact));
       }

@@ -39,7 +39,7 @@ struct Mover {
   double half_length = 0, s0 = 0, v0 = 0;
   SpeedProfile profile{{}};
   Following follow{};
-  bool obeys_signals = true;  // pedestrians cross on their own schedule
+  bool obeys_signals = true;                                // pedestrians cross on their own schedule
   std::vector<std::pair<double, const SignalSpec*>> stops;  // stop positions before signalled junctions
 };
 
@@ -52,6 +52,7 @@ struct Trace {
 };
 
 // Integrates every live mover (alive[i]) in steps of 10 ms; samples at each frame.
-Trace simulateLanes(const std::vector<Mover>& movers, const std::vector<bool>& alive, int frames, double frame_period_s);
+Trace simulateLanes(const std::vector<Mover>& movers, const std::vector<bool>& alive, int frames,
+                    double frame_period_s);
 
 }  // namespace dlslot::sim

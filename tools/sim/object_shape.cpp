@@ -12,8 +12,8 @@ double clampedNormal(Rng& rng, double mean, double sigma, double lo, double hi) 
 
 // A box part spanning x0..x1 along the object, width w, z0..z1 above the object's bottom.
 Solid part(double x0, double x1, double w, double z0, double z1, double bottom, float refl) {
-  return Solid::box(Eigen::Vector3d(0.5 * (x0 + x1), 0.0, bottom + 0.5 * (z0 + z1)), Eigen::Vector3d(x1 - x0, w, z1 - z0),
-                    0.0, refl);
+  return Solid::box(Eigen::Vector3d(0.5 * (x0 + x1), 0.0, bottom + 0.5 * (z0 + z1)),
+                    Eigen::Vector3d(x1 - x0, w, z1 - z0), 0.0, refl);
 }
 
 }  // namespace
@@ -34,7 +34,7 @@ Eigen::Vector3d sampleSize(const std::string& type, Rng& rng) {
 std::vector<Solid> objectParts(const std::string& type, const Eigen::Vector3d& size, float refl) {
   const double l = size.x(), w = size.y(), h = size.z(), bottom = -0.5 * h;
   const float glass = 0.5f * refl;  // windows return weaker
-  if (type == "Car")  // body to 58 % of the height, a shorter and narrower cabin on top
+  if (type == "Car")                // body to 58 % of the height, a shorter and narrower cabin on top
     return {part(-0.5 * l, 0.5 * l, w, 0.15, 0.58 * h, bottom, refl),
             part(-0.36 * l, 0.2 * l, 0.9 * w, 0.58 * h, h, bottom, glass)};
   if (type == "Van")
@@ -45,7 +45,8 @@ std::vector<Solid> objectParts(const std::string& type, const Eigen::Vector3d& s
             part(0.5 * l - 2.3, 0.5 * l, w, 0.4, 0.85 * h, bottom, refl),
             part(-0.5 * l, 0.5 * l - 2.5, w, 1.0, h, bottom, 0.6f)};
   if (type == "Cyclist") {  // the bicycle, the rider's body and head
-    Solid body = Solid::cylinder(Eigen::Vector2d(-0.1, 0.0), bottom + 0.9, bottom + h - 0.25, std::min(0.2, 0.45 * w), refl);
+    Solid body =
+        Solid::cylinder(Eigen::Vector2d(-0.1, 0.0), bottom + 0.9, bottom + h - 0.25, std::min(0.2, 0.45 * w), refl);
     return {part(-0.5 * l, 0.5 * l, 0.12, 0.05, 1.0, bottom, 0.35f), body,
             Solid::sphere(Eigen::Vector3d(-0.05, 0.0, bottom + h - 0.13), 0.12, refl)};
   }

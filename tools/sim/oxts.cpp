@@ -4,7 +4,8 @@
 
 namespace dlslot::sim {
 
-std::vector<kitti::OxtsRecord> simulatedOxts(const std::vector<Pose>& T_world_lidar, const Pose& T_velo_imu, double dt) {
+std::vector<kitti::OxtsRecord> simulatedOxts(const std::vector<Pose>& T_world_lidar, const Pose& T_velo_imu,
+                                             double dt) {
   std::vector<kitti::OxtsRecord> rows = kitti::lidarPosesToOxts(T_world_lidar, T_velo_imu, kLat0, kLon0, kAlt0);
   const int n = static_cast<int>(T_world_lidar.size());
   if (n < 2) return rows;
@@ -26,11 +27,11 @@ std::vector<kitti::OxtsRecord> simulatedOxts(const std::vector<Pose>& T_world_li
     r[6] = v.y();  // vn
     r[7] = v.x();  // ve
     for (int i = 0; i < 3; ++i) {
-      r[8 + i] = v_body[i];    // vf vl vu
-      r[11 + i] = f_body[i];   // ax ay az
-      r[14 + i] = f_body[i];   // af al au
-      r[17 + i] = w_body[i];   // wx wy wz
-      r[20 + i] = w_body[i];   // wf wl wu
+      r[8 + i] = v_body[i];   // vf vl vu
+      r[11 + i] = f_body[i];  // ax ay az
+      r[14 + i] = f_body[i];  // af al au
+      r[17 + i] = w_body[i];  // wx wy wz
+      r[20 + i] = w_body[i];  // wf wl wu
     }
     r[23] = 0.05;  // posacc, m
     r[24] = 0.02;  // velacc, m/s

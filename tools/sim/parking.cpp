@@ -25,7 +25,8 @@ std::vector<Agent> parkVehicles(const Scenario& sc, const World& world) {
         ag.parts = objectParts(ag.type, ag.size, static_cast<float>(rng.uniform(0.08, 0.5)));
         ag.parked = true;
         const Path::Sample at = road.centre.at(s);
-        const Eigen::Vector2d xy = at.p + side * ps.offset_m * Eigen::Vector2d(-std::sin(at.heading), std::cos(at.heading));
+        const Eigen::Vector2d xy =
+            at.p + side * ps.offset_m * Eigen::Vector2d(-std::sin(at.heading), std::cos(at.heading));
         // Parallel parkers face the traffic of their side; stall parkers face in or out.
         double heading = at.heading + (side > 0 ? M_PI : 0.0);
         if (ps.angle > 0) heading = at.heading + side * ps.angle + (rng.chance(0.5) ? M_PI : 0.0);

@@ -121,8 +121,9 @@ Path::Nearest Path::nearest(const Eigen::Vector2d& p) const {
       if (dist < best.distance) {
         best.distance = dist;
         best.s = s_[j] + f * (s_[j + 1] - s_[j]);
-        const Eigen::Vector2d dir = len2 > 0 ? Eigen::Vector2d(ab / std::sqrt(len2))
-                                             : Eigen::Vector2d(std::cos(samples_[j].heading), std::sin(samples_[j].heading));
+        const Eigen::Vector2d dir = len2 > 0
+                                        ? Eigen::Vector2d(ab / std::sqrt(len2))
+                                        : Eigen::Vector2d(std::cos(samples_[j].heading), std::sin(samples_[j].heading));
         best.lateral = dir.x() * (p - q).y() - dir.y() * (p - q).x();
       }
     }

@@ -31,9 +31,7 @@ class Rng {
   // Uniform in [0, 1) with 53 random bits.
   double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
   double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
-  int uniformInt(int lo, int hi_inclusive) {
-    return lo + static_cast<int>(uniform() * (hi_inclusive - lo + 1));
-  }
+  int uniformInt(int lo, int hi_inclusive) { return lo + static_cast<int>(uniform() * (hi_inclusive - lo + 1)); }
   bool chance(double p) { return uniform() < p; }
   // Box-Muller; one value per call keeps the stream simple to reason about.
   double normal(double mean = 0.0, double sigma = 1.0) {

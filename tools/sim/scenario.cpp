@@ -103,7 +103,8 @@ RouteSpec readRoute(Section s) {
       piece.curvature = (turn > 0 ? 1.0 : -1.0) / radius;
       if (turn == 0) p.fail("turn_deg", "expected a non-zero angle");
     } else {
-      throw ConfigError(p.cfg.file() + ": " + p.cfg.path() + ": expected `straight: METRES` or `turn_deg` + `radius_m`");
+      throw ConfigError(p.cfg.file() + ": " + p.cfg.path() +
+                        ": expected `straight: METRES` or `turn_deg` + `radius_m`");
     }
     p.cfg.finish();
     r.pieces.push_back(piece);

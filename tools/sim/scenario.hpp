@@ -32,32 +32,32 @@ struct RouteSpec {
   double transition_m = 10.0;
 };
 
-struct ParkingSpec {  // parked vehicles along a road (both sides)
-  double offset_m = 0.0;       // distance of the parked cars' centres from the centreline
-  Interval spacing_m;          // centre to centre
-  double fill = 1.0;           // fraction of slots occupied
-  double angle = 0.0;          // rad; 0 = parallel parking, pi/2 = perpendicular stalls
+struct ParkingSpec {      // parked vehicles along a road (both sides)
+  double offset_m = 0.0;  // distance of the parked cars' centres from the centreline
+  Interval spacing_m;     // centre to centre
+  double fill = 1.0;      // fraction of slots occupied
+  double angle = 0.0;     // rad; 0 = parallel parking, pi/2 = perpendicular stalls
 };
 
-struct RoadsideSpec {  // static structure along both sides of a road
-  double frontage_m = 12.0;     // building fronts start this far from the centreline
-  double buildings = 0.0;       // fraction of the frontage with buildings
+struct RoadsideSpec {        // static structure along both sides of a road
+  double frontage_m = 12.0;  // building fronts start this far from the centreline
+  double buildings = 0.0;    // fraction of the frontage with buildings
   Interval building_length_m{8, 30}, building_depth_m{8, 20}, building_height_m{5, 20};
-  double walls = 0.0;           // probability of a wall closing a gap between buildings
-  double poles_every_m = 0.0, poles_offset_m = 7.0;   // 0 = none
+  double walls = 0.0;                                // probability of a wall closing a gap between buildings
+  double poles_every_m = 0.0, poles_offset_m = 7.0;  // 0 = none
   double trees_every_m = 0.0, trees_offset_m = 9.0;
-  double bushes_every_m = 0.0;  // scattered vegetation beyond the frontage
+  double bushes_every_m = 0.0;       // scattered vegetation beyond the frontage
   double guard_rail_offset_m = 0.0;  // 0 = none
   bool median_barrier = false;
-  double noise_walls = 0.0;     // fraction of the frontage with a 3-4 m noise barrier
+  double noise_walls = 0.0;  // fraction of the frontage with a 3-4 m noise barrier
 };
 
 struct RoadSpec {
   std::string name;
   RouteSpec route;
-  std::vector<double> lanes;     // lane centres, m left of the centreline; lanes left of it drive the other way
-  double carriageway_m = 7.0;    // driving width: parked cars and structure stay out of it
-  double clear_m = 20.0;         // width kept free of static structure (carriageway + parking + sidewalks)
+  std::vector<double> lanes;   // lane centres, m left of the centreline; lanes left of it drive the other way
+  double carriageway_m = 7.0;  // driving width: parked cars and structure stay out of it
+  double clear_m = 20.0;       // width kept free of static structure (carriageway + parking + sidewalks)
   std::optional<ParkingSpec> parking;
   RoadsideSpec roadside;
 };
@@ -67,13 +67,13 @@ struct RoadSpec {
 struct SignalSpec {
   Eigen::Vector2d at = Eigen::Vector2d::Zero();
   double radius_m = 10.0;
-  double axis = 0.0;  // rad
+  double axis = 0.0;          // rad
   std::vector<Interval> red;  // time intervals, s
 };
 
 // Where an agent (or the ego) moves: a lane of a road, its own route, or across a road.
 struct PathSpec {
-  std::string road;              // with `lane`
+  std::string road;  // with `lane`
   double lane = 0.0;
   std::optional<RouteSpec> route;
   std::optional<double> crossing_s_m;  // straight across `road` at this arc length (pedestrians)
@@ -90,8 +90,8 @@ struct TrafficSpec {
   std::map<std::string, double> classes;  // class name -> relative weight
   int count = 0;
   Interval start_s_m, speed_mps;
-  Interval start_time_s;        // agents stand still until then
-  double speed_changes = 0.0;   // mean number of cruise-speed changes per agent
+  Interval start_time_s;          // agents stand still until then
+  double speed_changes = 0.0;     // mean number of cruise-speed changes per agent
   double stop_probability = 0.0;  // chance an agent stops for a while somewhere
 };
 
@@ -104,7 +104,7 @@ struct SensorSpec {  // HDL-64E-like (issue 3)
 };
 
 struct GroundSpec {
-  double max_slope = 0.03;          // bound on the grade of the gentle undulation
+  double max_slope = 0.03;  // bound on the grade of the gentle undulation
   Interval wavelength_m{150, 400};
 };
 
@@ -112,15 +112,15 @@ struct LabelSpec {
   int min_points = 10;  // fewer points on an object: DontCare
 };
 
-struct DetectorSpec {  // simulated 3D detector (SECOND-like probabilities as scores)
-  double points_for_half = 8.0;   // detection probability p_max (1 - 2^(-points / points_for_half))
+struct DetectorSpec {            // simulated 3D detector (SECOND-like probabilities as scores)
+  double points_for_half = 8.0;  // detection probability p_max (1 - 2^(-points / points_for_half))
   double max_probability = 0.97;
   double position_noise_m = 0.08, position_noise_per_m = 0.003;
-  double yaw_noise = 0.04;        // rad
-  double heading_flip = 0.02;     // chance a vehicle's heading is off by pi
-  double size_noise = 0.04;       // relative
+  double yaw_noise = 0.04;     // rad
+  double heading_flip = 0.02;  // chance a vehicle's heading is off by pi
+  double size_noise = 0.04;    // relative
   double false_positives_per_frame = 0.8;
-  double ghost_fraction = 0.05;   // share of poles/trees/bushes that repeatedly look like pedestrians
+  double ghost_fraction = 0.05;  // share of poles/trees/bushes that repeatedly look like pedestrians
 };
 
 struct Scenario {

@@ -12,10 +12,14 @@ namespace {
 
 float groundReflectivity(Surface s) {
   switch (s) {
-    case Surface::Asphalt: return 0.12f;
-    case Surface::Sidewalk: return 0.28f;
-    case Surface::Paint: return 0.6f;
-    case Surface::Grass: return 0.2f;
+    case Surface::Asphalt:
+      return 0.12f;
+    case Surface::Sidewalk:
+      return 0.28f;
+    case Surface::Paint:
+      return 0.6f;
+    case Surface::Grass:
+      return 0.2f;
   }
   return 0.2f;
 }
@@ -59,7 +63,8 @@ double beamElevationDeg(int beam) {
 }
 
 int aloamBeam(double angle) {
-  return angle >= -8.83 ? static_cast<int>((2 - angle) * 3.0 + 0.5) : 32 + static_cast<int>((-8.83 - angle) * 2.0 + 0.5);
+  return angle >= -8.83 ? static_cast<int>((2 - angle) * 3.0 + 0.5)
+                        : 32 + static_cast<int>((-8.83 - angle) * 2.0 + 0.5);
 }
 
 Scan scan(const SensorSpec& sensor, const ScanInput& in, int threads) {
@@ -69,7 +74,7 @@ Scan scan(const SensorSpec& sensor, const ScanInput& in, int threads) {
   // Object boxes as solids, for the rays-through-box counts.
   std::vector<Solid> box_solids;
   for (const Box& b : in.object_boxes) box_solids.push_back(Solid::box(b.center, b.size, b.yaw, 0.0f));
-  // Parts of each object, as index ranges into object_solids (grouped by owner).
+  // Each object's parts: indices into object_solids.
   std::vector<std::vector<int>> parts(in.object_boxes.size());
   for (size_t k = 0; k < in.object_solids.size(); ++k) parts[in.object_solids[k].owner].push_back(static_cast<int>(k));
 
@@ -129,11 +134,11 @@ Scan scan(const SensorSpec& sensor, const ScanInput& in, int threads) {
         }
         if (!hit || best < sensor.min_range_m) continue;
         const Eigen::Vector3d p = o + best * d;
-        const Eigen::Vector3d n = solid == -1 ? world.ground->normal(p.head<2>())
+        const Eigen::Vector3d n = solid == -1  ? world.ground->normal(p.head<2>())
                                   : solid >= 0 ? normalAt(world.grid->solids()[solid], p)
                                                : normalAt(in.object_solids[-2 - solid], p);
         const double incidence = std::abs(n.dot(d));
-        const float refl = solid == -1 ? groundReflectivity(world.ground->surface(p.head<2>()))
+        const float refl = solid == -1  ? groundReflectivity(world.ground->surface(p.head<2>()))
                            : solid >= 0 ? world.grid->solids()[solid].reflectivity
                                         : in.object_solids[-2 - solid].reflectivity;
         // Dropouts: random, more for dark surfaces far away, and at grazing incidence.
@@ -145,8 +150,7 @@ Scan scan(const SensorSpec& sensor, const ScanInput& in, int threads) {
         const double range = best + sensor.range_noise_m * n_range;
         // Reflectivity with a Lambertian-like falloff; the gain brings a typical street to KITTI's
         // mean reflectance (about 0.25), bright paint and signs saturate.
-        const double intensity =
-            std::clamp(1.6 * refl * (0.4 + 0.6 * incidence) * (1.0 + 0.1 * n_intensity), 0.0, 1.0);
+        const double intensity = std::clamp(1.6 * refl * (0.4 + 0.6 * incidence) * (1.0 + 0.1 * n_intensity), 0.0, 1.0);
         const Eigen::Vector3d q = range * dl;  // along the beam: the elevation stays the beam's
         bp.xyzi.insert(bp.xyzi.end(), {static_cast<float>(q.x()), static_cast<float>(q.y()), static_cast<float>(q.z()),
                                        static_cast<float>(intensity)});

@@ -55,7 +55,8 @@ SequenceStats writeSequence(const Scenario& scenario_in, int frames, uint64_t se
 
   stats.mean_points = points / frames;
   for (const kitti::LabelRow& r : labels) stats.labelled_tracks = std::max(stats.labelled_tracks, r.track_id + 1);
-  for (size_t k = 1; k < poses.size(); ++k) stats.path_length_m += (poses[k].translation() - poses[k - 1].translation()).norm();
+  for (size_t k = 1; k < poses.size(); ++k)
+    stats.path_length_m += (poses[k].translation() - poses[k - 1].translation()).norm();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (options.progress) progress.finish();
   return stats;

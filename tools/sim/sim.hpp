@@ -20,12 +20,12 @@ namespace dlslot::sim {
 
 struct SequenceStats {
   int frames = 0;
-  double seconds = 0;           // wall time
-  double mean_points = 0;       // per scan
-  int objects = 0;              // moving and parked objects in the world
-  int removed = 0;              // objects dropped because their paths would overlap
-  int labelled_tracks = 0;      // track ids given
-  double path_length_m = 0;     // of the ego
+  double seconds = 0;        // wall time
+  double mean_points = 0;    // per scan
+  int objects = 0;           // moving and parked objects in the world
+  int removed = 0;           // objects dropped because their paths would overlap
+  int labelled_tracks = 0;   // track ids given
+  double path_length_m = 0;  // of the ego
 };
 
 struct WriteOptions {

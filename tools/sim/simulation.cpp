@@ -9,8 +9,11 @@
 namespace dlslot::sim {
 
 Simulation::Simulation(const Scenario& scenario)
-    : scenario_(scenario), world_(buildWorld(scenario_)), motion_(simulateMotion(scenario_, world_)),
-      calib_(kittiCalib()), ghosts_(chooseGhosts(world_, scenario_.detector, streamKey({scenario_.seed, 5}))),
+    : scenario_(scenario),
+      world_(buildWorld(scenario_)),
+      motion_(simulateMotion(scenario_, world_)),
+      calib_(kittiCalib()),
+      ghosts_(chooseGhosts(world_, scenario_.detector, streamKey({scenario_.seed, 5}))),
       track_id_(motion_.agents.size(), -1) {}
 
 std::vector<Pose> Simulation::lidarPoses() const {
@@ -49,8 +52,8 @@ Simulation::FrameData Simulation::frame(int index, int threads) {
     const bool dontcare = view.points < scenario_.labels.min_points;
     if (!dontcare && id < 0) id = next_track_id_++;
     // DontCare rows keep the real 3D box so an evaluator can ignore matches there in bird's-eye view.
-    fd.labels.push_back(labelRow(index, dontcare ? -1 : id, dontcare ? "DontCare" : box.type, box, calib_,
-                                 occlusionLevel(view)));
+    fd.labels.push_back(
+        labelRow(index, dontcare ? -1 : id, dontcare ? "DontCare" : box.type, box, calib_, occlusionLevel(view)));
     targets.push_back({box, id, view.points});
   }
   Rng rng(streamKey({scenario_.seed, 7, static_cast<uint64_t>(index)}));

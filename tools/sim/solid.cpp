@@ -142,9 +142,12 @@ void project(const Footprint& f, const Eigen::Vector2d& axis, double& lo, double
 
 bool intersect(const Solid& solid, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double& s) {
   switch (solid.kind) {
-    case SolidKind::Box: return intersectBox(solid, o, d, max_s, s);
-    case SolidKind::Cylinder: return intersectCylinder(solid, o, d, max_s, s);
-    case SolidKind::Sphere: return intersectSphere(solid, o, d, max_s, s);
+    case SolidKind::Box:
+      return intersectBox(solid, o, d, max_s, s);
+    case SolidKind::Cylinder:
+      return intersectCylinder(solid, o, d, max_s, s);
+    case SolidKind::Sphere:
+      return intersectSphere(solid, o, d, max_s, s);
   }
   return false;
 }

@@ -17,7 +17,7 @@ namespace dlslot::sim {
 struct Agent {
   std::string type;
   Eigen::Vector3d size = Eigen::Vector3d::Zero();  // l, w, h
-  std::vector<Solid> parts;                         // in the box's own frame
+  std::vector<Solid> parts;                        // in the box's own frame
   bool parked = false;
   // Per frame: the box's footprint centre (map frame), heading and speed.
   std::vector<Eigen::Vector2d> xy;

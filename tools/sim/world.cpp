@@ -74,10 +74,12 @@ class RoadsideBuilder {
     const Eigen::Vector2d ax = along(yaw), ay = leftOf(yaw);
     double low = w_.ground->height(c);
     for (int i = -1; i <= 1; i += 2)
-      for (int j = -1; j <= 1; j += 2) low = std::min(low, w_.ground->height(c + 0.5 * (i * length * ax + j * width * ay)));
+      for (int j = -1; j <= 1; j += 2)
+        low = std::min(low, w_.ground->height(c + 0.5 * (i * length * ax + j * width * ay)));
     const double z0 = lift > 0 ? w_.ground->height(c) + lift : low - 0.5;
     const double z1 = w_.ground->height(c) + lift + height;
-    return Solid::box(Eigen::Vector3d(c.x(), c.y(), 0.5 * (z0 + z1)), Eigen::Vector3d(length, width, z1 - z0), yaw, refl);
+    return Solid::box(Eigen::Vector3d(c.x(), c.y(), 0.5 * (z0 + z1)), Eigen::Vector3d(length, width, z1 - z0), yaw,
+                      refl);
   }
 
   void buildings(const Road& road, int side) {
@@ -106,8 +108,8 @@ class RoadsideBuilder {
         }
         if (rng_.chance(0.25) && height > 6) {
           const double ul = length * rng_.uniform(0.4, 0.8), ud = depth * rng_.uniform(0.4, 0.8);
-          parts.push_back(standing(c + side * 0.25 * (depth - ud) * leftOf(yaw), yaw, ul, ud, rng_.uniform(2.5, 5), refl,
-                                   height - 0.05));
+          parts.push_back(standing(c + side * 0.25 * (depth - ud) * leftOf(yaw), yaw, ul, ud, rng_.uniform(2.5, 5),
+                                   refl, height - 0.05));
         }
         if (!add(StructureKind::Building, parts, road)) length = rng_.uniform(3, 8);  // try again a bit further on
       }
@@ -132,13 +134,15 @@ class RoadsideBuilder {
       const double g = w_.ground->height(c);
       if (rng_.chance(0.3)) {  // a traffic sign: thin post, a plate facing the traffic
         const double h = rng_.uniform(2.2, 2.8);
-        Solid plate = Solid::box(Eigen::Vector3d(c.x(), c.y(), g + h), Eigen::Vector3d(0.05, 0.7, 0.7), at.heading, 0.9f);
+        Solid plate =
+            Solid::box(Eigen::Vector3d(c.x(), c.y(), g + h), Eigen::Vector3d(0.05, 0.7, 0.7), at.heading, 0.9f);
         add(StructureKind::Sign, {Solid::cylinder(c, g - 0.2, g + h, 0.04, 0.4f), plate}, road);
         continue;
       }
       const double h = rng_.uniform(6, 9), r = rng_.uniform(0.09, 0.15);
       std::vector<Solid> parts{Solid::cylinder(c, g - 0.2, g + h, r, 0.45f)};
-      Solid arm = Solid::box(Eigen::Vector3d(c.x(), c.y(), g + h - 0.1), Eigen::Vector3d(0.12, 1.4, 0.12), at.heading, 0.45f);
+      Solid arm =
+          Solid::box(Eigen::Vector3d(c.x(), c.y(), g + h - 0.1), Eigen::Vector3d(0.12, 1.4, 0.12), at.heading, 0.45f);
       arm.center.head<2>() -= side * 0.7 * leftOf(at.heading);  // reaching over the road
       if (w_.keepsOffRoads(arm, &road)) parts.push_back(arm);
       add(StructureKind::Pole, parts, road);
@@ -182,8 +186,8 @@ class RoadsideBuilder {
       const Path::Sample a = road.centre.at(s), m = road.centre.at(s + 2);
       const Eigen::Vector2d pc = a.p + off * leftOf(a.heading), rc = m.p + off * leftOf(m.heading);
       const double g = w_.ground->height(pc);
-      Solid rail = Solid::box(Eigen::Vector3d(rc.x(), rc.y(), w_.ground->height(rc) + 0.6), Eigen::Vector3d(4.02, 0.1, 0.32),
-                              m.heading, 0.55f);
+      Solid rail = Solid::box(Eigen::Vector3d(rc.x(), rc.y(), w_.ground->height(rc) + 0.6),
+                              Eigen::Vector3d(4.02, 0.1, 0.32), m.heading, 0.55f);
       rail.center.head<2>() -= side * 0.1 * leftOf(m.heading);  // the rail hangs on the road side of its posts
       add(StructureKind::GuardRail, {Solid::cylinder(pc, g - 0.2, g + 0.75, 0.07, 0.4f), rail}, road);
     }

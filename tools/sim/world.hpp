@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "ground.hpp"
 #include "grid.hpp"
+#include "ground.hpp"
 #include "path.hpp"
 #include "scenario.hpp"
 
@@ -28,7 +28,7 @@ struct Road {
 
 struct World {
   std::vector<Road> roads;
-  std::vector<Path> routes;           // the ego's and agents' own routes (not roads), kept clear too
+  std::vector<Path> routes;  // the ego's and agents' own routes (not roads), kept clear too
   std::unique_ptr<Ground> ground;
   std::vector<Structure> structures;  // Solid::owner indexes this
   std::unique_ptr<SolidGrid> grid;    // every static solid

@@ -10,7 +10,7 @@
 #include "../tests/odometry_scene.hpp"
 #include "dlslot/kitti.hpp"
 #include "dlslot/timing_stats.hpp"
-#include "lidar_odometry.hpp"
+#include "odometry/lidar_odometry.hpp"
 
 using namespace dlslot;
 using namespace dlslot::odometry;

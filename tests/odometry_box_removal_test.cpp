@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "dlslot/box_filter.hpp"
-#include "lidar_odometry.hpp"
+#include "odometry/lidar_odometry.hpp"
 #include "odometry_scene.hpp"
 
 namespace dlslot::odometry {

@@ -3,7 +3,7 @@
 
 #include <fstream>
 
-#include "odometry_config.hpp"
+#include "odometry/odometry_config.hpp"
 
 namespace dlslot::odometry {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <limits>
 
-#include "lidar_odometry.hpp"
+#include "odometry/lidar_odometry.hpp"
 #include "odometry_scene.hpp"
 
 namespace dlslot::odometry {

@@ -6,9 +6,9 @@
 #include <limits>
 #include <map>
 
-#include "beam_index.hpp"
-#include "curvature.hpp"
-#include "feature_extraction.hpp"
+#include "odometry/beam_index.hpp"
+#include "odometry/curvature.hpp"
+#include "odometry/feature_extraction.hpp"
 #include "odometry_scene.hpp"
 
 namespace dlslot::odometry {

@@ -1,7 +1,7 @@
 // Joining LIDAR_SCAN and DETECTIONS by frame, with a timeout (the node's input logic).
 #include <gtest/gtest.h>
 
-#include "scan_joiner.hpp"
+#include "odometry/scan_joiner.hpp"
 
 namespace dlslot::odometry {
 namespace {

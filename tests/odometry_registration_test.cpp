@@ -6,11 +6,11 @@
 #include <filesystem>
 
 #include "dlslot/kitti.hpp"
-#include "lidar_odometry.hpp"
+#include "odometry/lidar_odometry.hpp"
 #include "odometry_scene.hpp"
-#include "rigid_motion.hpp"
-#include "scan_to_map.hpp"
-#include "scan_to_scan.hpp"
+#include "odometry/rigid_motion.hpp"
+#include "odometry/scan_to_map.hpp"
+#include "odometry/scan_to_scan.hpp"
 
 namespace dlslot::odometry {
 namespace {

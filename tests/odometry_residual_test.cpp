@@ -4,10 +4,10 @@
 
 #include <random>
 
-#include "edge_residual.hpp"
-#include "plane_residual.hpp"
-#include "pose_solver.hpp"
-#include "rigid_motion.hpp"
+#include "odometry/edge_residual.hpp"
+#include "odometry/plane_residual.hpp"
+#include "odometry/pose_solver.hpp"
+#include "odometry/rigid_motion.hpp"
 
 namespace dlslot::odometry {
 namespace {

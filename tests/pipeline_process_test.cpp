@@ -6,10 +6,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <signal.h>
 #include <thread>
 
 #include "dlslot/associations_t.hpp"
 #include "dlslot/odometry_t.hpp"
+#include "dlslot/process_status_t.hpp"
 #include "dlslot/slot_state_t.hpp"
 #include "process_harness.hpp"
 

@@ -49,12 +49,12 @@ struct BackendConfig {
   double switch_distance = 0.6;
   int switch_frames = 2;
 
-  // Ceres (Levenberg-Marquardt, sparse normal Cholesky).
-  int max_iterations = 3;
+  // Levenberg-Marquardt (WindowSolver) steps per frame and stopping tolerances.
+  int max_iterations = 2;
   double function_tolerance = 1e-6;
   double gradient_tolerance = 1e-10;
   double parameter_tolerance = 1e-8;
-  // Marginal covariances of the newest ego pose and the tracks (ceres::Covariance).
+  // Marginal covariances of the newest ego pose and the tracks (WindowSolver::covariance).
   bool compute_covariance = true;
 
   // Reads every key above from `section` (not finish(): the node reads its own keys too).

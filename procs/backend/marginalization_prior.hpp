@@ -8,7 +8,6 @@
 
 #include <ceres/cost_function.h>
 
-#include <memory>
 #include <vector>
 
 #include "backend/se3.hpp"
@@ -30,15 +29,6 @@ class MarginalizationPrior final : public ceres::CostFunction {
   // without forming Jx^T Jx from the (dense) rows: J^T J and J^T r0 are kept from construction.
   void linearize(double const* const* x, Eigen::MatrixXd& H, Eigen::VectorXd& g) const;
 
-  // The residual rows of block i's tangent and their Jacobians: when J is block upper
-  // triangular (the Marginalizer's Cholesky factor), rows 6i.. touch only blocks i.. . The
-  // solver adds each such row block as its own residual block, so Ceres never multiplies the
-  // zeros (see SlidingWindow::solve).
-  bool isBlockUpperTriangular() const { return upper_triangular_; }
-  bool evaluateRows(int i, double const* const* x, double* residuals, double** jacobians) const;
-  // Those rows as a cost function on blocks i..n-1 (it refers to this prior, which must outlive it).
-  std::unique_ptr<ceres::CostFunction> rowBlock(int i) const;
-
   int numBlocks() const { return static_cast<int>(x_lin_.size()); }
   int numRows() const { return static_cast<int>(r0_.size()); }
   const std::vector<Vector7>& linearizationPoints() const { return x_lin_; }
@@ -49,7 +39,6 @@ class MarginalizationPrior final : public ceres::CostFunction {
   Eigen::VectorXd r0_;
   Eigen::MatrixXd JtJ_;
   Eigen::VectorXd Jtr0_;
-  bool upper_triangular_ = false;
 };
 
 }  // namespace dlslot::backend

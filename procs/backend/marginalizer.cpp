@@ -5,28 +5,11 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "backend/factor_linearization.hpp"
 #include "backend/marginalization_prior.hpp"
-#include "backend/pose_manifold.hpp"
 
 namespace dlslot::backend {
 namespace {
-
-// Ceres' robust-loss correction (Triggs et al.): with s = |r|^2 and rho(s), the corrected
-// residual and Jacobian give the same Gauss-Newton step as Ceres takes.
-void applyLoss(const ceres::LossFunction& loss, Eigen::VectorXd& r, Eigen::MatrixXd& J) {
-  const double s = r.squaredNorm();
-  double rho[3];
-  loss.Evaluate(s, rho);
-  const double sqrt_rho1 = std::sqrt(std::max(rho[1], 0.0));
-  if (s == 0.0 || rho[2] <= 0.0) {
-    r *= sqrt_rho1;
-    J *= sqrt_rho1;
-    return;
-  }
-  const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * s * rho[2] / rho[1]);
-  J = sqrt_rho1 * (J - (alpha / s) * r * (r.transpose() * J));
-  r *= sqrt_rho1 / (1.0 - alpha);
-}
 
 // H* = H_rr - H_rm H_mm^-1 H_mr and g* = g_r - H_rm H_mm^-1 g_m for the first nm rows/columns
 // leaving. With H_mm = L L^T and Y = L^-1 [H_mr g_m]: H* = H_rr - Y^T Y (a symmetric rank
@@ -105,36 +88,18 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
     const int nb = static_cast<int>(f->blocks.size());
     std::vector<int> at(nb);
     for (int k = 0; k < nb; ++k) at[k] = fixed.count(f->blocks[k]) ? -1 : 6 * index.at(f->blocks[k]);
-    if (const auto* prior = dynamic_cast<const MarginalizationPrior*>(f->cost.get())) {
-      Eigen::MatrixXd Hf;
-      Eigen::VectorXd gf;
-      prior->linearize(f->blocks.data(), Hf, gf);
-      for (int a = 0; a < nb; ++a) {
-        if (at[a] < 0) continue;
-        g.segment(at[a], 6) += gf.segment<6>(6 * a);
-        for (int b = 0; b < nb; ++b)
-          if (at[b] >= 0) H.block<6, 6>(at[a], at[b]) += Hf.block<6, 6>(6 * a, 6 * b);
-      }
-      continue;
-    }
-    const int rows = f->cost->num_residuals();
-    Eigen::VectorXd r(rows);
-    std::vector<Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>> J_amb(nb);
-    std::vector<double*> jac_ptrs(nb);
-    for (int k = 0; k < nb; ++k) {
-      J_amb[k].resize(rows, 7);
-      jac_ptrs[k] = J_amb[k].data();
-    }
-    f->cost->Evaluate(f->blocks.data(), r.data(), jac_ptrs.data());
-    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(rows, 6 * nb);
-    for (int k = 0; k < nb; ++k)
-      if (at[k] >= 0) J.middleCols(6 * k, 6) = J_amb[k] * PoseManifold::plusJacobian(f->blocks[k]);
-    if (f->loss) applyLoss(*f->loss, r, J);
+    const FactorLinearization lin = linearize(*f, fixed);
     for (int a = 0; a < nb; ++a) {
       if (at[a] < 0) continue;
-      g.segment(at[a], 6) += J.middleCols(6 * a, 6).transpose() * r;
+      if (lin.is_prior) {
+        g.segment(at[a], 6) += lin.g.segment<6>(6 * a);
+        for (int b = 0; b < nb; ++b)
+          if (at[b] >= 0) H.block<6, 6>(at[a], at[b]) += lin.H.block<6, 6>(6 * a, 6 * b);
+        continue;
+      }
+      g.segment(at[a], 6) += lin.J[a].transpose() * lin.r;
       for (int b = 0; b < nb; ++b)
-        if (at[b] >= 0) H.block(at[a], at[b], 6, 6) += J.middleCols(6 * a, 6).transpose() * J.middleCols(6 * b, 6);
+        if (at[b] >= 0) H.block<6, 6>(at[a], at[b]) += lin.J[a].transpose() * lin.J[b];
     }
   }
 

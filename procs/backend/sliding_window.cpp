@@ -1,6 +1,7 @@
 #include "backend/sliding_window.hpp"
 
-#include <ceres/ceres.h>
+
+#include <ceres/loss_function.h>
 
 #include <chrono>
 #include <stdexcept>
@@ -239,64 +240,55 @@ void SlidingWindow::makeDynamic(Track& track) {
 
 void SlidingWindow::solve(BackendOutput& out) {
   const auto t0 = Clock::now();
-  ceres::Problem::Options po;
-  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  std::vector<std::unique_ptr<ceres::CostFunction>> prior_rows;  // outlives the problem
-  ceres::Problem problem(po);
-  int variable = 0;
-  for (double* b : liveBlocks()) {
-    problem.AddParameterBlock(b, kPoseSize, &manifold_);
-    if (fixed_.count(b)) {
-      problem.SetParameterBlockConstant(b);
-    } else {
-      ++variable;
+  // Separator: ego poses, landmarks and whatever the prior holds, the newest ego pose and the
+  // landmarks last (their covariances come from the factorization's tail). Groups: each
+  // dynamic object's poses and pose changes outside the prior.
+  std::unordered_set<const double*> in_prior;
+  for (const Factor& f : factors_)
+    if (dynamic_cast<const MarginalizationPrior*>(f.cost.get())) in_prior.insert(f.blocks.begin(), f.blocks.end());
+  std::vector<double*> separator, landmarks;
+  std::vector<std::vector<double*>> groups;
+  for (size_t i = 0; i + 1 < frames_.size(); ++i) separator.push_back(frames_[i].pose->data());
+  for (const auto& [id, track] : tracks_) {
+    if (track.landmark) landmarks.push_back(track.landmark->data());
+    // In time order, o_f then c_f: the group's matrix is then banded (WindowSolver).
+    std::vector<double*> group;
+    for (const auto& [f, o] : track.poses) {
+      auto c = track.changes.find(f);
+      for (double* b : {o->data(), c == track.changes.end() ? nullptr : c->second->data()})
+        if (b) (in_prior.count(b) ? separator : group).push_back(b);
     }
+    if (!group.empty()) groups.push_back(std::move(group));
   }
-  for (const Factor& f : factors_) {
-    const auto* prior = dynamic_cast<const MarginalizationPrior*>(f.cost.get());
-    if (!prior || !prior->isBlockUpperTriangular()) {
-      problem.AddResidualBlock(f.cost.get(), f.loss.get(), f.blocks);
-      continue;
-    }
-    for (int i = 0; i < prior->numBlocks(); ++i) {
-      prior_rows.push_back(prior->rowBlock(i));
-      problem.AddResidualBlock(prior_rows.back().get(), nullptr,
-                               std::vector<double*>(f.blocks.begin() + i, f.blocks.end()));
-    }
-  }
-  out.stats.num_blocks = problem.NumParameterBlocks();
+  separator.insert(separator.end(), landmarks.begin(), landmarks.end());
+  separator.push_back(frames_.back().pose->data());
+  std::vector<const Factor*> factors;
+  for (const Factor& f : factors_) factors.push_back(&f);
+  out.stats.num_blocks = static_cast<int>(liveBlocks().size());
   out.stats.num_factors = static_cast<int>(factors_.size());
-  if (variable > 0 && !factors_.empty()) {
-    ceres::Solver::Options so;
-    so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-    // Eigen's sparse Cholesky runs on this thread; SuiteSparse's BLAS spawns threads that only
-    // compete with the other processes for the cores.
-    so.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
-    so.max_num_iterations = config_.max_iterations;
-    so.function_tolerance = config_.function_tolerance;
-    so.gradient_tolerance = config_.gradient_tolerance;
-    so.parameter_tolerance = config_.parameter_tolerance;
-    so.num_threads = 1;
-    so.logging_type = ceres::SILENT;
-    ceres::Solver::Summary summary;
-    ceres::Solve(so, &problem, &summary);
-    out.stats.iterations = static_cast<int>(summary.iterations.size()) - 1;
-    out.stats.initial_cost = summary.initial_cost;
-    out.stats.final_cost = summary.final_cost;
-  }
+
+  WindowSolver::Options so;
+  so.max_iterations = config_.max_iterations;
+  so.function_tolerance = config_.function_tolerance;
+  so.gradient_tolerance = config_.gradient_tolerance;
+  so.parameter_tolerance = config_.parameter_tolerance;
+  const auto summary = solver_.solve(factors, separator, groups, fixed_, static_cast<int>(landmarks.size()) + 1, so);
+  out.stats.iterations = summary.iterations;
+  out.stats.initial_cost = summary.initial_cost;
+  out.stats.final_cost = summary.final_cost;
   out.stats.solve_ms = msSince(t0);
   const auto t1 = Clock::now();
-  fillTracks(out, variable > 0 && config_.compute_covariance ? &problem : nullptr);
+  fillTracks(out);
   out.stats.covariance_ms = msSince(t1);
 }
 
-void SlidingWindow::fillTracks(BackendOutput& out, ceres::Problem* problem) {
+void SlidingWindow::fillTracks(BackendOutput& out) {
   const int t = frames_.back().frame;
-  double* x_t = frames_.back().pose->data();
-  std::vector<std::pair<const double*, const double*>> wanted;
-  std::vector<std::pair<TrackEstimate, const double*>> estimates;
+  auto covariance = [&](const double* block) -> Matrix6 {
+    if (!config_.compute_covariance) return Matrix6::Zero();
+    return solver_.covariance(block).value_or(Matrix6::Zero());
+  };
+  out.ego_covariance = covariance(frames_.back().pose->data());
   for (const auto& [id, track] : tracks_) {
     if (track.model == TrackModel::kNotInGraph) continue;
     TrackEstimate e;
@@ -332,23 +324,9 @@ void SlidingWindow::fillTracks(BackendOutput& out, ceres::Problem* problem) {
         }
       }
     }
-    if (block && problem && !fixed_.count(block)) wanted.emplace_back(block, block);
-    estimates.emplace_back(e, block);
+    if (block) e.covariance = covariance(block);
+    out.tracks.push_back(std::move(e));
   }
-  if (problem) {
-    const bool ego_estimated = !fixed_.count(x_t);
-    if (ego_estimated) wanted.emplace_back(x_t, x_t);
-    ceres::Covariance::Options co;
-    co.algorithm_type = ceres::SPARSE_QR;
-    co.num_threads = 1;
-    ceres::Covariance covariance(co);
-    if (!wanted.empty() && covariance.Compute(wanted, problem)) {
-      if (ego_estimated) covariance.GetCovarianceBlockInTangentSpace(x_t, x_t, out.ego_covariance.data());
-      for (auto& [e, block] : estimates)
-        if (block && !fixed_.count(block)) covariance.GetCovarianceBlockInTangentSpace(block, block, e.covariance.data());
-    }
-  }
-  for (auto& [e, block] : estimates) out.tracks.push_back(std::move(e));
 }
 
 // ---- step 5: slide the window ----

@@ -6,7 +6,7 @@
 //   2. add the frame's observations: O_init get observation factors (eq. 9 / landmark), O_aso
 //      pose-change factors (eq. 10), O_cons constant-velocity factors (eq. 11);
 //   3. turn landmarks that started to move into dynamic objects;
-//   4. solve eq. 12;
+//   4. solve eq. 12 (WindowSolver: Levenberg-Marquardt with a per-object Schur complement);
 //   5. when the window is full, marginalize the oldest frame (its ego pose, object poses and
 //      pose changes, and the objects that left the view) into the prior.
 #pragma once
@@ -23,10 +23,7 @@
 #include "backend/marginalizer.hpp"
 #include "backend/motion_evidence.hpp"
 #include "backend/pose_manifold.hpp"
-
-namespace ceres {
-class Problem;
-}
+#include "backend/window_solver.hpp"
 
 namespace dlslot::backend {
 
@@ -84,7 +81,7 @@ class SlidingWindow {
   int switchMovingLandmarks();
   void makeDynamic(Track& track);
   void solve(BackendOutput& out);
-  void fillTracks(BackendOutput& out, ceres::Problem* problem);
+  void fillTracks(BackendOutput& out);
   SmoothedPose slide();
 
   void addFactor(ceres::CostFunction* cost, bool robust, std::vector<double*> blocks);
@@ -97,8 +94,8 @@ class SlidingWindow {
   std::vector<double*> liveBlocks() const;
 
   BackendConfig config_;
-  PoseManifold manifold_;
   Marginalizer marginalizer_;
+  WindowSolver solver_;
   std::shared_ptr<ceres::LossFunction> observation_loss_;
   std::deque<EgoFrame> frames_;
   std::map<int, Track> tracks_;

@@ -1,0 +1,72 @@
+#include "backend/factor_linearization.hpp"
+
+#include <cmath>
+
+#include "backend/marginalization_prior.hpp"
+#include "backend/pose_manifold.hpp"
+
+namespace dlslot::backend {
+namespace {
+
+// Ceres' robust-loss correction (Triggs et al.): with s = |r|^2 and rho(s), the corrected
+// residual and Jacobian give the same Gauss-Newton step as Ceres takes.
+void applyLoss(const ceres::LossFunction& loss, FactorLinearization& lin) {
+  const double s = lin.r.squaredNorm();
+  double rho[3];
+  loss.Evaluate(s, rho);
+  const double sqrt_rho1 = std::sqrt(std::max(rho[1], 0.0));
+  if (s == 0.0 || rho[2] <= 0.0) {
+    lin.r *= sqrt_rho1;
+    for (auto& J : lin.J) J *= sqrt_rho1;
+    return;
+  }
+  const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * s * rho[2] / rho[1]);
+  for (auto& J : lin.J)
+    if (J.size()) J = sqrt_rho1 * (J - (alpha / s) * lin.r * (lin.r.transpose() * J));
+  lin.r *= sqrt_rho1 / (1.0 - alpha);
+}
+
+}  // namespace
+
+FactorLinearization linearize(const Factor& f, const std::unordered_set<const double*>& fixed) {
+  FactorLinearization lin;
+  const int nb = static_cast<int>(f.blocks.size());
+  if (const auto* prior = dynamic_cast<const MarginalizationPrior*>(f.cost.get())) {
+    lin.is_prior = true;
+    prior->linearize(f.blocks.data(), lin.H, lin.g);
+    for (int k = 0; k < nb; ++k) {
+      if (!fixed.count(f.blocks[k])) continue;
+      lin.H.middleRows(6 * k, 6).setZero();
+      lin.H.middleCols(6 * k, 6).setZero();
+      lin.g.segment<6>(6 * k).setZero();
+    }
+    return lin;
+  }
+  const int rows = f.cost->num_residuals();
+  lin.r.resize(rows);
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>> J_amb(nb);
+  std::vector<double*> jac(nb, nullptr);
+  for (int k = 0; k < nb; ++k) {
+    if (fixed.count(f.blocks[k])) continue;
+    J_amb[k].resize(rows, 7);
+    jac[k] = J_amb[k].data();
+  }
+  f.cost->Evaluate(f.blocks.data(), lin.r.data(), jac.data());
+  lin.J.resize(nb);
+  for (int k = 0; k < nb; ++k)
+    if (jac[k]) lin.J[k] = J_amb[k] * PoseManifold::plusJacobian(f.blocks[k]);
+  if (f.loss) applyLoss(*f.loss, lin);
+  return lin;
+}
+
+double factorCost(const Factor& f) {
+  Eigen::VectorXd r(f.cost->num_residuals());
+  f.cost->Evaluate(f.blocks.data(), r.data(), nullptr);
+  const double s = r.squaredNorm();
+  if (!f.loss) return 0.5 * s;
+  double rho[3];
+  f.loss->Evaluate(s, rho);
+  return 0.5 * rho[0];
+}
+
+}  // namespace dlslot::backend

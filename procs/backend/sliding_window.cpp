@@ -240,17 +240,16 @@ void SlidingWindow::makeDynamic(Track& track) {
 
 void SlidingWindow::solve(BackendOutput& out) {
   const auto t0 = Clock::now();
-  // Separator: ego poses, landmarks and whatever the prior holds, the newest ego pose and the
-  // landmarks last (their covariances come from the factorization's tail). Groups: each
-  // dynamic object's poses and pose changes outside the prior.
+  // Separator: the object blocks the prior holds, then the landmarks and the ego poses (the
+  // factorization's tail, whose covariances are exact). Groups: each dynamic object's poses
+  // and pose changes outside the prior.
   std::unordered_set<const double*> in_prior;
   for (const Factor& f : factors_)
     if (dynamic_cast<const MarginalizationPrior*>(f.cost.get())) in_prior.insert(f.blocks.begin(), f.blocks.end());
-  std::vector<double*> separator, landmarks;
+  std::vector<double*> separator, tail;
   std::vector<std::vector<double*>> groups;
-  for (size_t i = 0; i + 1 < frames_.size(); ++i) separator.push_back(frames_[i].pose->data());
   for (const auto& [id, track] : tracks_) {
-    if (track.landmark) landmarks.push_back(track.landmark->data());
+    if (track.landmark) tail.push_back(track.landmark->data());
     // In time order, o_f then c_f: the group's matrix is then banded (WindowSolver).
     std::vector<double*> group;
     for (const auto& [f, o] : track.poses) {
@@ -260,8 +259,8 @@ void SlidingWindow::solve(BackendOutput& out) {
     }
     if (!group.empty()) groups.push_back(std::move(group));
   }
-  separator.insert(separator.end(), landmarks.begin(), landmarks.end());
-  separator.push_back(frames_.back().pose->data());
+  for (const EgoFrame& f : frames_) tail.push_back(f.pose->data());
+  separator.insert(separator.end(), tail.begin(), tail.end());
   std::vector<const Factor*> factors;
   for (const Factor& f : factors_) factors.push_back(&f);
   out.stats.num_blocks = static_cast<int>(liveBlocks().size());
@@ -272,7 +271,7 @@ void SlidingWindow::solve(BackendOutput& out) {
   so.function_tolerance = config_.function_tolerance;
   so.gradient_tolerance = config_.gradient_tolerance;
   so.parameter_tolerance = config_.parameter_tolerance;
-  const auto summary = solver_.solve(factors, separator, groups, fixed_, static_cast<int>(landmarks.size()) + 1, so);
+  const auto summary = solver_.solve(factors, separator, groups, fixed_, static_cast<int>(tail.size()), so);
   out.stats.iterations = summary.iterations;
   out.stats.initial_cost = summary.initial_cost;
   out.stats.final_cost = summary.final_cost;

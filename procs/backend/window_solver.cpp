@@ -262,7 +262,7 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
   double radius = options.initial_trust_region_radius, decrease_factor = 2.0;
   Eigen::VectorXd step_sep;
   std::vector<Eigen::VectorXd> step_groups;
-  bool factored = false;
+  double factored_mu = -1;  // damping of the last factorization, -1: none yet
   linearizeAll(factors, fixed);
   for (int it = 0; it < options.max_iterations; ++it) {
     if (max_gradient_ <= options.gradient_tolerance) break;
@@ -272,7 +272,7 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
       decrease_factor *= 2;
       continue;
     }
-    factored = true;
+    factored_mu = 1.0 / radius;
     double step_norm2 = step_sep.squaredNorm(), x_norm2 = 0;
     for (const auto& s : step_groups) step_norm2 += s.squaredNorm();
     for (size_t i = 0; i < estimated.size(); ++i) {
@@ -301,7 +301,11 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
     }
   }
   summary.final_cost = cost;
-  if (!factored) factored = solveStep(1.0 / radius, step_sep, step_groups);
+  // Covariances want the undamped system; rejected steps near the minimum leave a strongly
+  // damped factorization behind, so factor again then (the tiny mu only guards against
+  // rounding).
+  bool factored = factored_mu >= 0;
+  if (tail_dim_ > 0 && (!factored || factored_mu > 1e-6)) factored = solveStep(1e-12, step_sep, step_groups);
   if (factored && tail_dim_ > 0) {
     const Eigen::MatrixXd L_tail = Eigen::MatrixXd(sep_llt_.matrixL()).bottomRightCorner(tail_dim_, tail_dim_);
     const Eigen::MatrixXd L_inv = L_tail.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(tail_dim_, tail_dim_));

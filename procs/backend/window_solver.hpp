@@ -41,8 +41,8 @@ class WindowSolver {
                 int tail, const Options& options);
 
   // Marginal covariance in the PoseManifold's tangent, from the last linearization: exact for
-  // the separator's tail blocks; for a group block, its covariance given the separator plus
-  // what the tail blocks' uncertainty adds through it (the rest of the separator is left out).
+  // the separator's tail blocks; for a group block, exact when every separator block the group
+  // touches is in the tail, else without the correlations through the others.
   std::optional<Matrix6> covariance(const double* block) const;
 
  private:

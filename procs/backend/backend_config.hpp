@@ -22,9 +22,11 @@ struct BackendConfig {
 
   // Standard deviations [tx ty tz (m), rx ry rz (rad)] of each factor's residual; the
   // information matrix is diag(sigma)^-2 (the Sigma of eq. 12).
-  Vector6 odometry_sigma = (Vector6() << 0.05, 0.05, 0.05, 0.0005, 0.0005, 0.0005).finished();
-  Vector6 observation_sigma = (Vector6() << 0.25, 0.15, 0.15, 0.05, 0.05, 0.1).finished();
-  Vector6 landmark_sigma = (Vector6() << 0.15, 0.1, 0.1, 0.05, 0.05, 0.05).finished();
+  // Boxes carry no roll or pitch and a loose height, hence the large z, rx, ry sigmas of the
+  // (landmark) observations.
+  Vector6 odometry_sigma = (Vector6() << 0.02, 0.02, 0.02, 0.0003, 0.0003, 0.0003).finished();
+  Vector6 observation_sigma = (Vector6() << 0.25, 0.15, 0.3, 0.3, 0.3, 0.1).finished();
+  Vector6 landmark_sigma = (Vector6() << 0.15, 0.1, 0.3, 0.3, 0.3, 0.05).finished();
   Vector6 pose_change_sigma = (Vector6() << 0.02, 0.02, 0.02, 0.005, 0.005, 0.005).finished();
   Vector6 constant_velocity_sigma = (Vector6() << 0.05, 0.03, 0.02, 0.005, 0.005, 0.01).finished();
   Vector6 first_pose_sigma = (Vector6() << 1e-3, 1e-3, 1e-3, 1e-4, 1e-4, 1e-4).finished();

@@ -133,11 +133,13 @@ TEST(PipelineProcess, ReplayedOdometryAndAssociationsGiveTheSameSlotState) {
 
 TEST(PipelineProcess, KilledTrackerIsReportedAndTheLogKept) {
   const std::string out = scratchDir();
-  ChildProcess run(runArgs(out, {"--no-render", "--no-eval"}), out + "/../killed-run.log");
-  // Wait until the pipeline is running, then kill the tracker.
-  const std::string pidof = "pgrep -n -f dlslot-tracker > " + out + "/tracker.pid";
-  for (int i = 0; i < 200 && !fs::exists(out + "/run.lcmlog"); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  std::this_thread::sleep_for(std::chrono::seconds(3));
+  // Rate mode at half speed: 30 frames take 6 s, so the tracker dies mid-run.
+  ChildProcess run(runArgs(out, {"--no-render", "--no-eval", "--speed", "0.5"}), out + "/../killed-run.log");
+  // The bracket keeps pgrep from matching the shell that runs it.
+  const std::string pidof = "pgrep -n -f 'bin/[d]lslot-tracker' > " + out + "/tracker.pid";
+  for (int i = 0; i < 400 && !fs::exists(out + "/logs/player.log"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  std::this_thread::sleep_for(std::chrono::seconds(2));
   ASSERT_EQ(std::system(pidof.c_str()), 0);
   int pid = 0;
   std::ifstream(out + "/tracker.pid") >> pid;

@@ -130,7 +130,9 @@ void requireSameLength(const Trajectory& est, const std::string& est_file, const
 void exportRun(const std::string& dir, const RunLog* log, const RunData& run, const DataSet& data) {
   fs::create_directories(dir);
   const std::optional<Pose> Tr = camFromVelo(data);
-  for (const auto& [name, t] : run.sources) {
+  std::map<std::string, Trajectory> trajectories = run.sources;
+  if (run.truth) trajectories.emplace("groundtruth", *run.truth);
+  for (const auto& [name, t] : trajectories) {
     writeTrajectory((fs::path(dir) / ("trajectory_" + name + "_kitti.txt")).string(), t, TrajectoryFormat::Kitti);
     writeTrajectory((fs::path(dir) / ("trajectory_" + name + "_tum.txt")).string(), t, TrajectoryFormat::Tum);
     if (Tr)

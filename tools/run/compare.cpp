@@ -96,12 +96,15 @@ int compare(int argc, char** argv) {
         "RPE1 deg | MOTA | IDSW | velocity RMSE m/s |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (size_t i = 0; i < kModes.size(); ++i) {
     const YAML::Node& m = metrics[i];
+    const bool estimatesObjects = kModes[i].first == "slot" || kModes[i].first == "two-stage";
     md << "| " << kModes[i].second << " | " << cell(m, "ego.t_rel_pct", "%.2f") << " | "
        << cell(m, "ego.r_rel_deg_per_100m", "%.3f") << " | " << cell(m, "ego.t_rel_short_pct", "%.2f") << " | "
        << cell(m, "ego.r_rel_short_deg_per_100m", "%.3f") << " | " << cell(m, "ego.ate_rmse_m", "%.3f") << " | "
        << cell(m, "ego.rpe1_t_m", "%.4f") << " | " << cell(m, "ego.rpe1_r_deg", "%.4f") << " | "
-       << cell(m, "tracking.mota", "%.3f") << " | " << cell(m, "tracking.idsw", "%.0f") << " | "
-       << cell(m, "tracking.velocity_rmse_mps", "%.3f") << " |\n";
+       << (estimatesObjects ? cell(m, "tracking.mota", "%.3f") + " | " + cell(m, "tracking.idsw", "%.0f") + " | " +
+                                    cell(m, "tracking.velocity_rmse_mps", "%.3f")
+                              : std::string("- | - | -"))
+       << " |\n";
   }
   md << "\nA-LOAM and A-LOAM* run no object estimation, so their tracking columns are '-'.\n"
      << "\n## Table II: mean time per module per frame (ms)\n\n"

@@ -35,15 +35,6 @@ struct Listener {
   }
 };
 
-bool handleUntil(lcm::LCM& lcm, const std::function<bool()>& pred, double timeout_s) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  while (!pred()) {
-    if (std::chrono::steady_clock::now() > end) return false;
-    lcm.handleTimeout(20);
-  }
-  return true;
-}
-
 int64_t counter(const process_status_t& s, const std::string& name) {
   for (int i = 0; i < s.num_counters; ++i)
     if (s.counter_names[i] == name) return s.counter_values[i];

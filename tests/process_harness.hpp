@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <string>
@@ -104,6 +105,16 @@ class ChildProcess {
   bool exited_ = false;
   int status_ = 0;
 };
+
+// Handles LCM messages until pred() holds or timeout_s passes; returns pred().
+inline bool handleUntil(lcm::LCM& lcm, const std::function<bool()>& pred, double timeout_s) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (!pred()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    lcm.handleTimeout(20);
+  }
+  return true;
+}
 
 // All events of an LCM log, grouped by channel, in log order.
 inline std::map<std::string, std::vector<std::vector<uint8_t>>> readLog(const std::string& path) {

@@ -34,15 +34,6 @@ struct Listener {
   }
 };
 
-bool handleUntil(lcm::LCM& lcm, const std::function<bool()>& pred, double timeout_s) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  while (!pred()) {
-    if (std::chrono::steady_clock::now() > end) return false;
-    lcm.handleTimeout(20);
-  }
-  return true;
-}
-
 // The shipped config with a short join timeout, so the missing-ODOMETRY case is quick.
 std::string configWithTimeout(const std::string& dir, double timeout_s) {
   std::ifstream in(config());

@@ -97,6 +97,9 @@ struct SimScene {
           OdometryInput o;
           o.pose = odometry_pose;
           o.delta = delta;
+          // The true noise (not definite when a component has none: then the backend uses
+          // its configured sigmas).
+          o.covariance = odometry_noise.cwiseAbs2().asDiagonal();
           in.odometry = o;
         }
       } else {

@@ -132,11 +132,11 @@ SimScene streetScene() {
   return s;
 }
 
-// The backend's settings with the odometry covariance the street scene simulates.
+// The backend's settings for the street scene, whose odometry reports its true covariance.
 BackendConfig streetConfig() {
   BackendConfig c;
   c.compute_covariance = false;
-  c.odometry_sigma << 0.02, 0.02, 0.01, 0.002, 0.002, 0.003;
+  c.odometry_covariance_scale = 1.0;
   return c;
 }
 

@@ -9,7 +9,7 @@
 #include <stdexcept>
 
 #include "backend/backend_messages.hpp"
-#include "backend/frame_joiner.hpp"
+#include "dlslot/frame_joiner.hpp"
 #include "backend/sliding_window.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/timing_stats.hpp"

@@ -6,34 +6,64 @@
 #include <unordered_map>
 
 #include "backend/factor_linearization.hpp"
+#include "backend/se3.hpp"
 #include "backend/marginalization_prior.hpp"
 
 namespace dlslot::backend {
 namespace {
 
 // H* = H_rr - H_rm H_mm^-1 H_mr and g* = g_r - H_rm H_mm^-1 g_m for the first nm rows/columns
-// leaving. With H_mm = L L^T and Y = L^-1 [H_mr g_m]: H* = H_rr - Y^T Y (a symmetric rank
-// update). A singular H_mm (a direction no factor constrains, which carries no information to
+// leaving. With H_mm = L L^T and Y = L^-1 [H_mr g_m]: H* = H_rr - Y^T Y. A kept block is
+// coupled to few leaving ones (an object's next pose to its last one), so its columns of H_mr,
+// and of Y, are zero above the first leaving block it is coupled to: solve and multiply only
+// below it. A singular H_mm (a direction no factor constrains, which carries no information to
 // pass on) falls back to the pseudo-inverse.
 void schurComplement(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int nm, Eigen::MatrixXd& H_star,
                      Eigen::VectorXd& g_star) {
   const int nr = static_cast<int>(H.rows()) - nm;
-  Eigen::MatrixXd Y(nm, nr + 1);
-  Y << H.topRightCorner(nm, nr), g.head(nm);
+  H_star = H.bottomRightCorner(nr, nr);
+  g_star = g.tail(nr);
   Eigen::LLT<Eigen::MatrixXd> llt(H.topLeftCorner(nm, nm));
-  if (llt.info() == Eigen::Success) {
-    llt.matrixL().solveInPlace(Y);
-  } else {
+  if (llt.info() != Eigen::Success) {
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H.topLeftCorner(nm, nm));
     const double eps = 1e-10 * std::max(1.0, es.eigenvalues().cwiseAbs().maxCoeff());
     const Eigen::VectorXd inv_sqrt =
         (es.eigenvalues().array() > eps).select(es.eigenvalues().cwiseMax(eps).cwiseSqrt().cwiseInverse(), 0.0);
+    Eigen::MatrixXd Y(nm, nr + 1);
+    Y << H.topRightCorner(nm, nr), g.head(nm);
     Y = inv_sqrt.asDiagonal() * (es.eigenvectors().transpose() * Y);
+    H_star.noalias() -= Y.leftCols(nr).transpose() * Y.leftCols(nr);
+    g_star.noalias() -= Y.leftCols(nr).transpose() * Y.col(nr);
+    return;
   }
-  Eigen::MatrixXd S = H.bottomRightCorner(nr, nr);
-  S.selfadjointView<Eigen::Lower>().rankUpdate(Y.leftCols(nr).transpose(), -1.0);
-  H_star = S.selfadjointView<Eigen::Lower>();
-  g_star = g.tail(nr) - Y.leftCols(nr).transpose() * Y.col(nr);
+  const Eigen::MatrixXd& L = llt.matrixLLT();  // L in the lower triangle
+  const int kept = nr / 6;
+  std::vector<int> first(kept, nm);  // first row of each kept block's columns that is not zero
+  for (int c = 0; c < kept; ++c)
+    for (int row = 0; row < nm; row += 6)
+      if (!H.block<6, 6>(row, nm + 6 * c).isZero(0.0)) {
+        first[c] = row;
+        break;
+      }
+  Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(nm, nr);
+  for (int c = 0; c < kept; ++c) {
+    const int p = first[c], rows = nm - p;
+    if (rows == 0) continue;
+    Y.block(p, 6 * c, rows, 6) = H.block(p, nm + 6 * c, rows, 6);
+    L.block(p, p, rows, rows).triangularView<Eigen::Lower>().solveInPlace(Y.block(p, 6 * c, rows, 6));
+  }
+  const Eigen::VectorXd yg = L.triangularView<Eigen::Lower>().solve(g.head(nm));
+  for (int a = 0; a < kept; ++a) {
+    if (first[a] == nm) continue;
+    g_star.segment<6>(6 * a).noalias() -= Y.block(first[a], 6 * a, nm - first[a], 6).transpose() * yg.tail(nm - first[a]);
+    for (int b = 0; b <= a; ++b) {
+      const int p = std::max(first[a], first[b]);
+      if (p == nm) continue;
+      const Matrix6 S = Y.block(p, 6 * a, nm - p, 6).transpose() * Y.block(p, 6 * b, nm - p, 6);
+      H_star.block<6, 6>(6 * a, 6 * b) -= S;
+      if (b != a) H_star.block<6, 6>(6 * b, 6 * a) -= S.transpose();
+    }
+  }
 }
 
 // H = J^T J and g = J^T r  ->  (J, r); J is upper triangular when H is definite (returns

@@ -112,7 +112,7 @@ void SlidingWindow::addEgoFrame(const BackendInput& in) {
     Eigen::LLT<Matrix6> llt(in.odometry->covariance);
     // S = L^-1 with Sigma = L L^T gives S^T S = Sigma^-1.
     if (llt.info() == Eigen::Success && in.odometry->covariance.allFinite())
-      S = llt.matrixL().solve(Matrix6::Identity());
+      S = llt.matrixL().solve(Matrix6::Identity()) / config_.odometry_covariance_scale;
   }
   if (!have_odometry || !in.odometry->ok) S /= config_.degraded_odometry_scale;
   addFactor(OdometryFactor::Create(delta, S), false, {x_prev, x});

@@ -4,7 +4,7 @@
 
 #include <cstdlib>
 
-#include "backend/frame_joiner.hpp"
+#include "dlslot/frame_joiner.hpp"
 #include "backend_scene.hpp"
 #include "backend_test_messages.hpp"
 #include "dlslot/convert.hpp"

@@ -2,7 +2,6 @@
 #include <gtest/gtest.h>
 
 #include "ego_pose_chain.hpp"
-#include "frame_joiner.hpp"
 
 using namespace dlslot;
 using namespace dlslot::tracker;
@@ -98,49 +97,4 @@ TEST(TrackerEgoPose, ForgettingKeepsWhatTheChainNeeds) {
     EXPECT_TRUE(chain.poseAt(f).X.isApprox(odo.pose[f], 1e-9)) << f;
     chain.forgetBefore(f);
   }
-}
-
-TEST(TrackerFrameJoiner, CompleteFramesAreReleasedInOrder) {
-  FrameJoiner j(1.0);
-  DetectionFrame d;
-  d.utime = 100;
-  d.boxes.resize(2);
-  EXPECT_TRUE(j.addDetections(0, d, 0.0));
-  EXPECT_TRUE(j.release(0.1).empty());  // waits for ODOMETRY
-  EXPECT_TRUE(j.addOdometry(0, 100, 0.2));
-  auto out = j.release(0.2);
-  ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(out[0].frame, 0);
-  EXPECT_EQ(out[0].utime, 100);
-  EXPECT_FALSE(out[0].timed_out);
-  EXPECT_EQ(out[0].detections->boxes.size(), 2u);
-  EXPECT_FALSE(j.addOdometry(0, 100, 0.3));  // stale
-}
-
-TEST(TrackerFrameJoiner, TimeoutReleasesAnIncompleteFrame) {
-  FrameJoiner j(1.0);
-  j.addOdometry(3, 300, 10.0);
-  EXPECT_TRUE(j.release(10.9).empty());
-  auto out = j.release(11.0);
-  ASSERT_EQ(out.size(), 1u);
-  EXPECT_TRUE(out[0].timed_out);
-  EXPECT_FALSE(out[0].detections.has_value());
-  EXPECT_TRUE(out[0].has_odometry);
-  EXPECT_EQ(j.lastReleased(), 3);
-}
-
-TEST(TrackerFrameJoiner, ALaterCompleteFrameOvertakesAnIncompleteOne) {
-  FrameJoiner j(5.0);
-  j.addDetections(4, DetectionFrame{}, 0.0);  // its ODOMETRY never comes
-  j.addDetections(5, DetectionFrame{}, 0.1);
-  j.addOdometry(5, 500, 0.2);
-  auto out = j.release(0.2);
-  ASSERT_EQ(out.size(), 2u);
-  EXPECT_EQ(out[0].frame, 4);
-  EXPECT_TRUE(out[0].timed_out);
-  EXPECT_FALSE(out[0].has_odometry);
-  EXPECT_EQ(out[1].frame, 5);
-  EXPECT_FALSE(out[1].timed_out);
-  j.reset();
-  EXPECT_TRUE(j.addDetections(0, DetectionFrame{}, 1.0));
 }

@@ -11,11 +11,11 @@
 #include "dlslot/associations_t.hpp"
 #include "dlslot/convert.hpp"
 #include "dlslot/detections_t.hpp"
+#include "dlslot/frame_joiner.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/odometry_t.hpp"
 #include "dlslot/slot_state_t.hpp"
 #include "ego_pose_chain.hpp"
-#include "frame_joiner.hpp"
 #include "offline_run.hpp"
 #include "trajectory_associator.hpp"
 
@@ -55,6 +55,18 @@ std::string seconds(double s) {
   return buf;
 }
 
+// The well-formed detections of one DETECTIONS message (lidar frame).
+struct DetectionFrame {
+  int64_t utime = 0;
+  std::vector<Box> boxes;
+  std::vector<int> message_index;  // index of each box in the message
+  int num_rejected = 0;            // malformed boxes left out
+};
+// DETECTIONS and the ODOMETRY utime of one scan, joined by frame.
+using Joiner = FrameJoiner<DetectionFrame, int64_t>;
+using JoinedFrame = Joiner::Joined;
+int64_t utimeOf(const JoinedFrame& j) { return j.a ? j.a->utime : j.b.value_or(0); }
+
 double secondsNow() {
   return std::chrono::duration<double>(Node::Clock::now().time_since_epoch()).count();
 }
@@ -76,15 +88,15 @@ DetectionFrame toDetectionFrame(const detections_t& msg) {
 
 associations_t toMsg(const JoinedFrame& joined, const EgoPose& ego, const FrameAssociations& result) {
   associations_t m;
-  m.utime = joined.utime;
+  m.utime = utimeOf(joined);
   m.frame = joined.frame;
   m.ego_pose = dlslot::toMsg(ego.X);
   m.ego_pose_source = poseSourceName(ego.source);
   m.num_active_tracks = result.num_active_tracks;
-  m.num_rejected = joined.detections ? joined.detections->num_rejected : 0;
+  m.num_rejected = joined.a ? joined.a->num_rejected : 0;
   for (const Association& a : result.associations) {
     association_t out;
-    out.detection_index = joined.detections->message_index[a.detection_index];
+    out.detection_index = joined.a->message_index[a.detection_index];
     out.track_id = a.track_id;
     out.initialized = a.initialized;
     out.num_observations = a.num_observations;
@@ -159,17 +171,17 @@ int run(int argc, char** argv) {
   ProcessStatus& status = node.status();
   TrajectoryAssociator associator(cfg.associator);
   EgoPoseChain ego_poses;
-  FrameJoiner joiner(cfg.join_timeout_s);
+  Joiner joiner(cfg.join_timeout_s);
 
   auto process = [&](const JoinedFrame& joined) {
     const auto tic = Node::Clock::now();
     const std::string frame = std::to_string(joined.frame);
-    if (!joined.has_odometry) {
+    if (!joined.b) {
       status.timeout(channels.odometry + " for frame " + frame + " not within " +
                      seconds(cfg.join_timeout_s) + "; ego motion predicted");
       status.count("odometry_missing");
     }
-    if (!joined.detections) {
+    if (!joined.a) {
       status.timeout(channels.detections + " for frame " + frame + " not within " +
                      seconds(cfg.join_timeout_s) + "; frame handled as empty");
       status.count("detections_missing");
@@ -177,8 +189,8 @@ int run(int argc, char** argv) {
     const EgoPose ego = ego_poses.poseAt(joined.frame);
     status.count(std::string("pose_source_") + poseSourceName(ego.source));
     static const std::vector<Box> kNone;
-    const std::vector<Box>& boxes = joined.detections ? joined.detections->boxes : kNone;
-    const FrameAssociations result = associator.associate(joined.frame, joined.utime * 1e-6, ego.X, boxes);
+    const std::vector<Box>& boxes = joined.a ? joined.a->boxes : kNone;
+    const FrameAssociations result = associator.associate(joined.frame, utimeOf(joined) * 1e-6, ego.X, boxes);
     ego_poses.forgetBefore(joined.frame);
 
     for (const Association& a : result.associations) {
@@ -215,12 +227,12 @@ int run(int argc, char** argv) {
                    std::to_string(d.num_rejected) + " malformed box(es) (NaN/inf field or size <= 0) rejected");
       status.count("rejected_detections", d.num_rejected);
     }
-    if (!joiner.addDetections(msg.frame, std::move(d), secondsNow())) status.count("stale_messages");
+    if (!joiner.addA(msg.frame, std::move(d), secondsNow())) status.count("stale_messages");
     releaseReady();
   });
   node.subscribeFrames<odometry_t>(channels.odometry, [&](const odometry_t& msg) {
     restartIfRewound(msg.frame);
-    if (!joiner.addOdometry(msg.frame, msg.utime, secondsNow())) {
+    if (!joiner.addB(msg.frame, msg.utime, secondsNow())) {
       status.count("stale_messages");
       return;
     }

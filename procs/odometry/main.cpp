@@ -7,12 +7,12 @@
 
 #include "dlslot/convert.hpp"
 #include "dlslot/detections_t.hpp"
+#include "dlslot/frame_joiner.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/odometry_t.hpp"
 #include "dlslot/point_cloud_t.hpp"
 #include "lidar_odometry.hpp"
 #include "offline.hpp"
-#include "scan_joiner.hpp"
 
 using namespace dlslot;
 using namespace dlslot::odometry;
@@ -59,20 +59,22 @@ int runNode(const NodeOptions& node_opts, const Channels& channels, const Odomet
   Node node("odometry", node_opts.lcm_url, channels);
   ProcessStatus& status = node.status();
   LidarOdometry odometry(cfg);
-  ScanJoiner joiner(timeout_s, cfg.remove_detected_objects);
+  // A scan and its detections, joined by frame. In A-LOAM mode detections are not needed, so a
+  // scan is released as soon as it arrives (timeout 0) and detections are not fed in.
+  const bool need_detections = cfg.remove_detected_objects;
+  FrameJoiner<Frame, std::vector<Box>> joiner(need_detections ? timeout_s : 0.0);
   std::fprintf(stderr, "dlslot-odometry: mode %s\n", modeName(cfg.remove_detected_objects));
 
-  auto process = [&](JoinedScan& joined) {
+  auto process = [&](Frame& frame, bool has_detections) {
     const auto tic = Node::Clock::now();
-    const Frame& frame = joined.frame;
-    if (cfg.remove_detected_objects && !joined.has_detections) {
+    if (need_detections && !has_detections) {
       status.timeout(channels.detections + " for frame " + std::to_string(frame.index) + " not within " +
                      std::to_string(timeout_s) + " s; ran unfiltered");
       status.count("unfiltered_frames");
     }
     OdometryResult r;
     try {
-      r = odometry.process(frame, joined.has_detections);
+      r = odometry.process(frame, has_detections);
     } catch (const std::exception& e) {  // never take the pipeline down for one scan
       status.error("frame " + std::to_string(frame.index) + ": " + e.what() + "; odometry reset");
       odometry.reset();
@@ -82,13 +84,17 @@ int runNode(const NodeOptions& node_opts, const Channels& channels, const Odomet
       status.warn("frame " + std::to_string(frame.index) + ": " + r.status_text + "; constant-velocity prediction");
       status.count("fallback_frames");
     }
-    if (cfg.remove_detected_objects && !joined.has_detections)
+    if (need_detections && !has_detections)
       r.status_text += (r.status_text.empty() ? "" : "; ") + channels.detections + " timed out, ran unfiltered";
     node.publish(channels.odometry, toMsg(r, frame.utime));
     status.frameDone(frame.index, std::chrono::duration<double, std::milli>(Node::Clock::now() - tic).count());
   };
   auto releaseReady = [&] {
-    for (JoinedScan& joined : joiner.release(secondsNow())) process(joined);
+    for (auto& joined : joiner.release(secondsNow())) {
+      if (!joined.a) continue;  // detections whose scan never came
+      if (joined.b) joined.a->detections = std::move(*joined.b);
+      process(*joined.a, joined.b.has_value());
+    }
   };
   // A scan older than one already handled: the input restarted (a new run). Start over.
   auto restartIfRewound = [&](int frame) {
@@ -101,7 +107,11 @@ int runNode(const NodeOptions& node_opts, const Channels& channels, const Odomet
 
   node.subscribeFrames<point_cloud_t>(channels.scan, [&](const point_cloud_t& msg) {
     restartIfRewound(msg.frame);
-    if (!joiner.addScan(msg.frame, msg.utime, fromMsg(msg), secondsNow())) status.count("stale_messages");
+    Frame frame;
+    frame.index = msg.frame;
+    frame.utime = msg.utime;
+    frame.scan = fromMsg(msg);
+    if (!joiner.addA(msg.frame, std::move(frame), secondsNow())) status.count("stale_messages");
     releaseReady();
   });
   node.subscribeFrames<detections_t>(channels.detections, [&](const detections_t& msg) {
@@ -119,7 +129,7 @@ int runNode(const NodeOptions& node_opts, const Channels& channels, const Odomet
                    " malformed box(es) (NaN/inf field or size <= 0) ignored");
       status.count("rejected_detections", rejected);
     }
-    if (!joiner.addDetections(msg.frame, std::move(boxes), secondsNow())) status.count("stale_messages");
+    if (need_detections && !joiner.addB(msg.frame, std::move(boxes), secondsNow())) status.count("stale_messages");
     releaseReady();
   });
   node.every(0.02, releaseReady);

@@ -271,6 +271,7 @@ void SlidingWindow::solve(BackendOutput& out) {
   so.function_tolerance = config_.function_tolerance;
   so.gradient_tolerance = config_.gradient_tolerance;
   so.parameter_tolerance = config_.parameter_tolerance;
+  so.covariance = config_.compute_covariance;
   const auto summary = solver_.solve(factors, separator, groups, fixed_, static_cast<int>(tail.size()), so);
   out.stats.iterations = summary.iterations;
   out.stats.initial_cost = summary.initial_cost;

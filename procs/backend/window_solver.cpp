@@ -301,16 +301,16 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
     }
   }
   summary.final_cost = cost;
-  // Covariances want the undamped system; rejected steps near the minimum leave a strongly
-  // damped factorization behind, so factor again then (the tiny mu only guards against
-  // rounding).
-  bool factored = factored_mu >= 0;
-  if (tail_dim_ > 0 && (!factored || factored_mu > 1e-6)) factored = solveStep(1e-12, step_sep, step_groups);
-  if (factored && tail_dim_ > 0) {
-    const Eigen::MatrixXd L_tail = Eigen::MatrixXd(sep_llt_.matrixL()).bottomRightCorner(tail_dim_, tail_dim_);
-    const Eigen::MatrixXd L_inv = L_tail.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(tail_dim_, tail_dim_));
-    tail_cov_ = L_inv.transpose() * L_inv;  // (L_tail L_tail^T)^-1: the trailing blocks' marginal
-  }
+  if (!options.covariance || tail_dim_ == 0) return summary;
+  // Covariances want the undamped system: even mu = 1e-4 times the diagonal changes them by
+  // percents along the window's weakly determined directions (a chain's diagonal is much larger
+  // than its marginal information). Factor again when the last factorization was damped more
+  // than rounding (the tiny mu only guards against it).
+  if ((factored_mu < 0 || factored_mu > 1e-7) && !solveStep(1e-12, step_sep, step_groups)) return summary;
+  const Eigen::MatrixXd L_tail = sep_llt_.matrixLLT().bottomRightCorner(tail_dim_, tail_dim_);
+  Eigen::MatrixXd L_inv = Eigen::MatrixXd::Identity(tail_dim_, tail_dim_);
+  L_tail.triangularView<Eigen::Lower>().solveInPlace(L_inv);
+  tail_cov_ = L_inv.transpose() * L_inv;  // (L_tail L_tail^T)^-1: the trailing blocks' marginal
   return summary;
 }
 

@@ -26,7 +26,10 @@ class WindowSolver {
     double function_tolerance = 1e-6;   // |cost change| / cost
     double gradient_tolerance = 1e-10;  // max |gradient|
     double parameter_tolerance = 1e-8;  // |step| / (|x| + tol)
-    double initial_trust_region_radius = 1e4;
+    // Large: the window starts from the last solution, so Gauss-Newton steps (mu -> 0) are
+    // what it needs; rejected steps shrink the radius. Covariances also want mu -> 0.
+    double initial_trust_region_radius = 1e8;
+    bool covariance = true;  // prepare covariance() (may cost one more factorization)
   };
   struct Summary {
     int iterations = 0;  // steps tried (accepted or not)

@@ -1,6 +1,7 @@
 #include "backend/factor_linearization.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "backend/marginalization_prior.hpp"
 #include "backend/pose_manifold.hpp"
@@ -21,8 +22,8 @@ void applyLoss(const ceres::LossFunction& loss, FactorLinearization& lin) {
     return;
   }
   const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * s * rho[2] / rho[1]);
-  for (auto& J : lin.J)
-    if (J.size()) J = sqrt_rho1 * (J - (alpha / s) * lin.r * (lin.r.transpose() * J));
+  const Matrix6 P = Matrix6::Identity() - (alpha / s) * lin.r * lin.r.transpose();
+  for (auto& J : lin.J) J = sqrt_rho1 * (P * J);
   lin.r *= sqrt_rho1 / (1.0 - alpha);
 }
 
@@ -42,27 +43,32 @@ FactorLinearization linearize(const Factor& f, const std::unordered_set<const do
     }
     return lin;
   }
-  const int rows = f.cost->num_residuals();
-  lin.r.resize(rows);
-  std::vector<Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>> J_amb(nb);
+  if (f.cost->num_residuals() != 6) throw std::logic_error("linearize: expected a 6-dimensional residual");
+  std::vector<Matrix67> J_amb(nb);
   std::vector<double*> jac(nb, nullptr);
+  lin.estimated.resize(nb);
   for (int k = 0; k < nb; ++k) {
-    if (fixed.count(f.blocks[k])) continue;
-    J_amb[k].resize(rows, 7);
-    jac[k] = J_amb[k].data();
+    lin.estimated[k] = !fixed.count(f.blocks[k]);
+    if (lin.estimated[k]) jac[k] = J_amb[k].data();
   }
   f.cost->Evaluate(f.blocks.data(), lin.r.data(), jac.data());
-  lin.J.resize(nb);
+  lin.J.assign(nb, Matrix6::Zero());
   for (int k = 0; k < nb; ++k)
-    if (jac[k]) lin.J[k] = J_amb[k] * PoseManifold::plusJacobian(f.blocks[k]);
+    if (lin.estimated[k]) lin.J[k].noalias() = J_amb[k] * PoseManifold::plusJacobian(f.blocks[k]);
   if (f.loss) applyLoss(*f.loss, lin);
   return lin;
 }
 
 double factorCost(const Factor& f) {
-  Eigen::VectorXd r(f.cost->num_residuals());
-  f.cost->Evaluate(f.blocks.data(), r.data(), nullptr);
-  const double s = r.squaredNorm();
+  Vector6 small;
+  Eigen::VectorXd large;
+  double* r = small.data();
+  if (f.cost->num_residuals() != 6) {
+    large.resize(f.cost->num_residuals());
+    r = large.data();
+  }
+  f.cost->Evaluate(f.blocks.data(), r, nullptr);
+  const double s = Eigen::Map<const Eigen::VectorXd>(r, f.cost->num_residuals()).squaredNorm();
   if (!f.loss) return 0.5 * s;
   double rho[3];
   f.loss->Evaluate(s, rho);

@@ -9,12 +9,15 @@
 #include <vector>
 
 #include "backend/factor.hpp"
+#include "backend/se3.hpp"
 
 namespace dlslot::backend {
 
+// Every factor but the prior has a 6-dimensional residual (an SE(3) error), so fixed sizes.
 struct FactorLinearization {
-  Eigen::VectorXd r;                     // residual (robust loss applied)
-  std::vector<Eigen::MatrixXd> J;        // per block: rows x 6 tangent Jacobian; empty when fixed
+  Vector6 r = Vector6::Zero();           // residual (robust loss applied)
+  std::vector<Matrix6> J;                // per block: tangent Jacobian
+  std::vector<bool> estimated;           // per block: false when fixed (J unused)
   bool is_prior = false;                 // then H and g below instead of r and J
   Eigen::MatrixXd H;                     // 6n x 6n over the prior's blocks (fixed ones zero)
   Eigen::VectorXd g;

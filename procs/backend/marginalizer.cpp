@@ -127,9 +127,9 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
           if (at[b] >= 0) H.block<6, 6>(at[a], at[b]) += lin.H.block<6, 6>(6 * a, 6 * b);
         continue;
       }
-      g.segment(at[a], 6) += lin.J[a].transpose() * lin.r;
+      g.segment<6>(at[a]).noalias() += lin.J[a].transpose() * lin.r;
       for (int b = 0; b < nb; ++b)
-        if (at[b] >= 0) H.block<6, 6>(at[a], at[b]) += lin.J[a].transpose() * lin.J[b];
+        if (at[b] >= 0) H.block<6, 6>(at[a], at[b]).noalias() += lin.J[a].transpose() * lin.J[b];
     }
   }
 

@@ -142,13 +142,20 @@ void WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
       const Location& la = *loc[a];
       Group* group = la.group >= 0 ? &groups_[la.group] : nullptr;
       Eigen::VectorXd& g = group ? group->g : g_sep_;
-      g.segment<6>(la.offset) += lin.is_prior ? Eigen::VectorXd(lin.g.segment<6>(6 * a))
-                                              : Eigen::VectorXd(lin.J[a].transpose() * lin.r);
+      if (lin.is_prior) {
+        g.segment<6>(la.offset) += lin.g.segment<6>(6 * a);
+      } else {
+        g.segment<6>(la.offset).noalias() += lin.J[a].transpose() * lin.r;
+      }
       for (int b = 0; b < nb; ++b) {
         if (!loc[b]) continue;
         const Location& lb = *loc[b];
-        const Matrix6 block = lin.is_prior ? Matrix6(lin.H.block<6, 6>(6 * a, 6 * b))
-                                           : Matrix6(lin.J[a].transpose() * lin.J[b]);
+        Matrix6 block;
+        if (lin.is_prior) {
+          block = lin.H.block<6, 6>(6 * a, 6 * b);
+        } else {
+          block.noalias() = lin.J[a].transpose() * lin.J[b];
+        }
         if (la.group < 0 && lb.group < 0) {
           H_sep_.block<6, 6>(la.offset, lb.offset) += block;
         } else if (la.group == lb.group) {
@@ -230,9 +237,9 @@ double WindowSolver::modelCostChange(const std::vector<const Factor*>& factors, 
       change -= lin.g.dot(dx) + 0.5 * dx.dot(lin.H * dx);
       continue;
     }
-    Eigen::VectorXd Jdx = Eigen::VectorXd::Zero(lin.r.size());
+    Vector6 Jdx = Vector6::Zero();
     for (int a = 0; a < nb; ++a)
-      if (lin.J[a].size()) Jdx += lin.J[a] * stepOf(f.blocks[a], step_sep, step_groups);
+      if (lin.estimated[a]) Jdx += lin.J[a] * stepOf(f.blocks[a], step_sep, step_groups);
     change -= lin.r.dot(Jdx) + 0.5 * Jdx.squaredNorm();
   }
   return change;

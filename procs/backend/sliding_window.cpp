@@ -1,6 +1,5 @@
 #include "backend/sliding_window.hpp"
 
-
 #include <ceres/loss_function.h>
 
 #include <chrono>

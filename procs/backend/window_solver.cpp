@@ -39,7 +39,8 @@ bool WindowSolver::BandedCholesky::compute(const Eigen::MatrixXd& A) {
     const int m = std::min(bw, n - 1 - j);  // rows below the diagonal inside the band
     for (int k = std::max(0, j - bw); k < j; ++k) {
       const double ljk = L(j, k);
-      if (ljk != 0.0) L.col(j).segment(j, std::min(m + 1, k + bw + 1 - j)) -= ljk * L.col(k).segment(j, std::min(m + 1, k + bw + 1 - j));
+      const int rows = std::min(m + 1, k + bw + 1 - j);  // column k's band ends at row k + bw
+      if (ljk != 0.0) L.col(j).segment(j, rows) -= ljk * L.col(k).segment(j, rows);
     }
     const double d = L(j, j);
     if (!(d > 0.0)) return false;
@@ -64,10 +65,6 @@ void WindowSolver::BandedCholesky::solveLt(RowMatrix& B) const {
     B.row(j) /= L(j, j);
   }
 }
-
-namespace {
-
-}  // namespace
 
 void WindowSolver::setUp(const std::vector<double*>& separator, const std::vector<std::vector<double*>>& groups,
                          const std::unordered_set<const double*>& fixed, int tail) {

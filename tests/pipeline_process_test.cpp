@@ -135,8 +135,9 @@ TEST(PipelineProcess, KilledTrackerIsReportedAndTheLogKept) {
   const std::string out = scratchDir();
   // Rate mode at half speed: 30 frames take 6 s, so the tracker dies mid-run.
   ChildProcess run(runArgs(out, {"--no-render", "--no-eval", "--speed", "0.5"}), out + "/../killed-run.log");
-  // The bracket keeps pgrep from matching the shell that runs it.
-  const std::string pidof = "pgrep -n -f 'bin/[d]lslot-tracker' > " + out + "/tracker.pid";
+  // This run's own tracker (other tests may run trackers at the same time): a child of dlslot-run.
+  const std::string pidof =
+      "pgrep -P " + std::to_string(run.pid()) + " -f 'bin/[d]lslot-tracker' > " + out + "/tracker.pid";
   for (int i = 0; i < 400 && !fs::exists(out + "/logs/player.log"); ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   std::this_thread::sleep_for(std::chrono::seconds(2));

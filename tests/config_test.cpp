@@ -59,3 +59,17 @@ TEST(Config, ShippedConfigHasChannels) {
   EXPECT_NO_THROW(c.read(root.section("channels")));
   EXPECT_EQ(c.scan, "LIDAR_SCAN");
 }
+
+TEST(Config, PipelineConfigRejectsAMisspeltSection) {
+  const std::string ok = writeYaml("cfg_pipe_ok.yaml",
+                                   "channels: {scan: A, detections: B, ground_truth: C, odometry: D, associations: E,"
+                                   " slot_state: F, status: G}\ntracker: {}\n");
+  Channels c;
+  EXPECT_NO_THROW(loadPipelineConfig(ok, c));
+  EXPECT_EQ(c.slot_state, "F");
+  const std::string bad = writeYaml("cfg_pipe_bad.yaml",
+                                    "channels: {scan: A, detections: B, ground_truth: C, odometry: D, associations: E,"
+                                    " slot_state: F, status: G}\ntrackr: {}\n");
+  const std::string e = errorOf([&] { loadPipelineConfig(bad, c); });
+  EXPECT_NE(e.find("trackr (line 2): unknown key"), std::string::npos) << e;
+}

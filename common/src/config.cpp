@@ -100,4 +100,12 @@ void Channels::read(ConfigSection s) {
   s.finish();
 }
 
+ConfigSection loadPipelineConfig(const std::string& file, Channels& channels) {
+  ConfigSection root = loadConfig(file);
+  for (const char* section : {"channels", "player", "odometry", "tracker", "backend", "renderer"}) root.skip(section);
+  root.finish();
+  channels.read(root.section("channels"));
+  return root;
+}
+
 }  // namespace dlslot

@@ -198,9 +198,8 @@ int main(int argc, char** argv) {
     if (!cl.parse(argc, argv)) return 0;
     if (!offline_out.empty() && offline_in.empty()) throw std::invalid_argument("--out needs --offline");
 
-    ConfigSection root = loadConfig(opts.config);
     Channels channels;
-    channels.read(root.section("channels"));
+    ConfigSection root = loadPipelineConfig(opts.config, channels);
     ConfigSection section = root.section("backend");
     BackendConfig config = BackendConfig::read(section);
     double join_timeout_s = 0;

@@ -156,9 +156,8 @@ int run(int argc, char** argv) {
   node_opts.addTo(cl);
   if (!cl.parse(argc, argv)) return 0;
 
-  ConfigSection root_cfg = loadConfig(node_opts.config);
   Channels channels;
-  channels.read(root_cfg.section("channels"));
+  ConfigSection root_cfg = loadPipelineConfig(node_opts.config, channels);
   ConfigSection section = root_cfg.section("odometry");
   OdometryConfig cfg = readOdometryConfig(section);
   const double timeout_s = section.get<double>("detections_timeout_s");

@@ -49,9 +49,8 @@ int run(int argc, char** argv) {
   node_opts.addTo(cl);
   if (!cl.parse(argc, argv)) return 0;
 
-  ConfigSection root_cfg = loadConfig(node_opts.config);
   Channels channels;
-  channels.read(root_cfg.section("channels"));
+  ConfigSection root_cfg = loadPipelineConfig(node_opts.config, channels);
   PlayerConfig cfg;
   cfg.read(root_cfg.section("player"));
   if (node_opts.check_config) return 0;

@@ -131,9 +131,8 @@ int main(int argc, char** argv) {
     cl.option("--out", &out, "output directory for the images (required)");
     cl.option("--log", &log, "render a recorded LCM log instead of live traffic");
     if (!cl.parse(argc, argv)) return 0;
-    ConfigSection root = loadConfig(opts.config);
     Channels channels;
-    channels.read(root.section("channels"));
+    ConfigSection root = loadPipelineConfig(opts.config, channels);
     const RendererConfig cfg = readRendererConfig(root);
     if (opts.check_config) {
       std::cout << opts.config << ": renderer config OK\n";

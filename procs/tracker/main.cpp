@@ -159,9 +159,8 @@ int run(int argc, char** argv) {
   cl.flag("--initialized-only", &off.initialized_only, "offline: output only initialized associations (III-D)");
   if (!cl.parse(argc, argv)) return 0;
 
-  ConfigSection root_cfg = loadConfig(node_opts.config);
   Channels channels;
-  channels.read(root_cfg.section("channels"));
+  ConfigSection root_cfg = loadPipelineConfig(node_opts.config, channels);
   TrackerConfig cfg;
   cfg.read(root_cfg.section("tracker"));
   if (node_opts.check_config) return 0;

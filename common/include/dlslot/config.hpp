@@ -65,4 +65,10 @@ struct Channels {
   void read(ConfigSection section);
 };
 
+// Loads the pipeline's one config file for a process: every top-level key must be one of the
+// known sections (a misspelt section name is an error, not a block silently ignored), and the
+// channel names are read into `channels`. Returns the root, from which the process reads its
+// own section.
+ConfigSection loadPipelineConfig(const std::string& file, Channels& channels);
+
 }  // namespace dlslot

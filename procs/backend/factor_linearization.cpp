@@ -29,34 +29,56 @@ void applyLoss(const ceres::LossFunction& loss, FactorLinearization& lin) {
 
 }  // namespace
 
-FactorLinearization linearize(const Factor& f, const std::unordered_set<const double*>& fixed) {
-  FactorLinearization lin;
+void linearize(const Factor& f, const std::unordered_set<const double*>& fixed, FactorLinearization& lin) {
   const int nb = static_cast<int>(f.blocks.size());
-  if (const auto* prior = dynamic_cast<const MarginalizationPrior*>(f.cost.get())) {
-    lin.is_prior = true;
-    prior->linearize(f.blocks.data(), lin.H, lin.g);
-    for (int k = 0; k < nb; ++k) {
-      if (!fixed.count(f.blocks[k])) continue;
-      lin.H.middleRows(6 * k, 6).setZero();
-      lin.H.middleCols(6 * k, 6).setZero();
-      lin.g.segment<6>(6 * k).setZero();
-    }
-    return lin;
+  lin.estimated.resize(nb);
+  for (int k = 0; k < nb; ++k) lin.estimated[k] = !fixed.count(f.blocks[k]);
+  lin.prior = dynamic_cast<const MarginalizationPrior*>(f.cost.get());
+  if (lin.prior) {
+    lin.prior->gradient(f.blocks.data(), lin.M, lin.g);
+    for (int k = 0; k < nb; ++k)
+      if (!lin.estimated[k]) lin.g.segment<6>(6 * k).setZero();
+    return;
   }
   if (f.cost->num_residuals() != 6) throw std::logic_error("linearize: expected a 6-dimensional residual");
-  std::vector<Matrix67> J_amb(nb);
-  std::vector<double*> jac(nb, nullptr);
-  lin.estimated.resize(nb);
-  for (int k = 0; k < nb; ++k) {
-    lin.estimated[k] = !fixed.count(f.blocks[k]);
-    if (lin.estimated[k]) jac[k] = J_amb[k].data();
-  }
-  f.cost->Evaluate(f.blocks.data(), lin.r.data(), jac.data());
-  lin.J.assign(nb, Matrix6::Zero());
+  if (nb > 3) throw std::logic_error("linearize: expected at most 3 blocks");
+  Matrix67 J_amb[3];
+  double* jac[3] = {nullptr, nullptr, nullptr};
   for (int k = 0; k < nb; ++k)
-    if (lin.estimated[k]) lin.J[k].noalias() = J_amb[k] * PoseManifold::plusJacobian(f.blocks[k]);
+    if (lin.estimated[k]) jac[k] = J_amb[k].data();
+  f.cost->Evaluate(f.blocks.data(), lin.r.data(), jac);
+  lin.J.resize(nb);
+  for (int k = 0; k < nb; ++k) {
+    if (lin.estimated[k]) {
+      lin.J[k].noalias() = J_amb[k] * PoseManifold::plusJacobian(f.blocks[k]);
+    } else {
+      lin.J[k].setZero();
+    }
+  }
   if (f.loss) applyLoss(*f.loss, lin);
-  return lin;
+}
+
+Vector6 FactorLinearization::gradientBlock(int a) const {
+  if (prior) return g.segment<6>(6 * a);
+  return J[a].transpose() * r;
+}
+
+Matrix6 FactorLinearization::hessianBlock(int a, int b) const {
+  if (prior) return prior->hessianBlock(M, a, b);
+  return J[a].transpose() * J[b];
+}
+
+double FactorLinearization::modelDecrease(const std::vector<Vector6>& dx) const {
+  const int nb = static_cast<int>(estimated.size());
+  if (prior) {
+    Eigen::VectorXd d(6 * nb);
+    for (int a = 0; a < nb; ++a) d.segment<6>(6 * a) = estimated[a] ? dx[a] : Vector6::Zero();
+    return -(g.dot(d) + 0.5 * prior->curvature(M, d));
+  }
+  Vector6 Jdx = Vector6::Zero();
+  for (int a = 0; a < nb; ++a)
+    if (estimated[a]) Jdx.noalias() += J[a] * dx[a];
+  return -(r.dot(Jdx) + 0.5 * Jdx.squaredNorm());
 }
 
 double factorCost(const Factor& f) {

@@ -33,24 +33,38 @@ bool MarginalizationPrior::Evaluate(double const* const* x, double* residuals, d
   return true;
 }
 
-void MarginalizationPrior::linearize(double const* const* x, Eigen::MatrixXd& H, Eigen::VectorXd& g) const {
+void MarginalizationPrior::gradient(double const* const* x, std::vector<Matrix6>& M, Eigen::VectorXd& g) const {
   const int n = numBlocks();
   Eigen::VectorXd dx(kTangentSize * n);
-  std::vector<Matrix6> M(n);
+  M.resize(n);
   for (int i = 0; i < n; ++i) {
     const Pose xi = fromBlock(x[i]), li = fromBlock(x_lin_[i].data());
     dx.segment<6>(6 * i) = minus(xi, li);
     M[i] = minusJacobianAt(xi, li);
   }
-  // Jx = J blockdiag(M): H = M^T (J^T J) M, g = M^T J^T (r0 + J dx).
-  const Eigen::VectorXd g0 = Jtr0_ + JtJ_ * dx;
-  H.resize(6 * n, 6 * n);
+  Eigen::VectorXd g0 = Jtr0_;
+  g0.noalias() += JtJ_ * dx;
   g.resize(6 * n);
-  for (int i = 0; i < n; ++i) {
-    g.segment<6>(6 * i) = M[i].transpose() * g0.segment<6>(6 * i);
-    for (int j = 0; j < n; ++j)
-      H.block<6, 6>(6 * i, 6 * j) = M[i].transpose() * JtJ_.block<6, 6>(6 * i, 6 * j) * M[j];
-  }
+  for (int i = 0; i < n; ++i) g.segment<6>(6 * i).noalias() = M[i].transpose() * g0.segment<6>(6 * i);
+}
+
+Matrix6 MarginalizationPrior::hessianBlock(const std::vector<Matrix6>& M, int i, int j) const {
+  return M[i].transpose() * JtJ_.block<6, 6>(6 * i, 6 * j) * M[j];
+}
+
+void MarginalizationPrior::linearize(double const* const* x, Eigen::MatrixXd& H, Eigen::VectorXd& g) const {
+  std::vector<Matrix6> M;
+  gradient(x, M, g);
+  const int n = numBlocks();
+  H.resize(6 * n, 6 * n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) H.block<6, 6>(6 * i, 6 * j) = hessianBlock(M, i, j);
+}
+
+double MarginalizationPrior::curvature(const std::vector<Matrix6>& M, const Eigen::VectorXd& dx) const {
+  Eigen::VectorXd Mdx(dx.size());
+  for (int i = 0; i < numBlocks(); ++i) Mdx.segment<6>(6 * i).noalias() = M[i] * dx.segment<6>(6 * i);
+  return Mdx.dot(JtJ_ * Mdx);
 }
 
 }  // namespace dlslot::backend

@@ -25,9 +25,16 @@ class MarginalizationPrior final : public ceres::CostFunction {
 
   bool Evaluate(double const* const* x, double* residuals, double** jacobians) const override;
 
-  // Gauss-Newton terms at x in the blocks' tangent spaces: H = Jx^T Jx and g = Jx^T r(x),
-  // without forming Jx^T Jx from the (dense) rows: J^T J and J^T r0 are kept from construction.
+  // The Gauss-Newton terms at x in the blocks' tangent spaces, without forming Jx^T Jx from the
+  // dense rows: Jx = J blockdiag(M) with M_i = d(x_i [-] x_lin_i)/dx_i, so the gradient is
+  // g = M^T (J^T r0 + J^T J dx) and the Hessian's blocks M_i^T (J^T J)_ij M_j (hessianBlock),
+  // formed only where a solver needs them. J^T J and J^T r0 are kept from construction.
+  void gradient(double const* const* x, std::vector<Matrix6>& M, Eigen::VectorXd& g) const;
+  Matrix6 hessianBlock(const std::vector<Matrix6>& M, int i, int j) const;
+  // The whole H = Jx^T Jx and g = Jx^T r(x) (for tests and small priors).
   void linearize(double const* const* x, Eigen::MatrixXd& H, Eigen::VectorXd& g) const;
+  // |Jx dx|^2 for a tangent step dx over every block.
+  double curvature(const std::vector<Matrix6>& M, const Eigen::VectorXd& dx) const;
 
   int numBlocks() const { return static_cast<int>(x_lin_.size()); }
   int numRows() const { return static_cast<int>(r0_.size()); }

@@ -114,22 +114,17 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
   // Linearize every factor at the current estimate into the dense H, g.
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(nm + nr, nm + nr);
   Eigen::VectorXd g = Eigen::VectorXd::Zero(nm + nr);
+  FactorLinearization lin;
   for (const Factor* f : factors) {
     const int nb = static_cast<int>(f->blocks.size());
     std::vector<int> at(nb);
     for (int k = 0; k < nb; ++k) at[k] = fixed.count(f->blocks[k]) ? -1 : 6 * index.at(f->blocks[k]);
-    const FactorLinearization lin = linearize(*f, fixed);
+    linearize(*f, fixed, lin);
     for (int a = 0; a < nb; ++a) {
       if (at[a] < 0) continue;
-      if (lin.is_prior) {
-        g.segment(at[a], 6) += lin.g.segment<6>(6 * a);
-        for (int b = 0; b < nb; ++b)
-          if (at[b] >= 0) H.block<6, 6>(at[a], at[b]) += lin.H.block<6, 6>(6 * a, 6 * b);
-        continue;
-      }
-      g.segment<6>(at[a]).noalias() += lin.J[a].transpose() * lin.r;
+      g.segment<6>(at[a]) += lin.gradientBlock(a);
       for (int b = 0; b < nb; ++b)
-        if (at[b] >= 0) H.block<6, 6>(at[a], at[b]).noalias() += lin.J[a].transpose() * lin.J[b];
+        if (at[b] >= 0) H.block<6, 6>(at[a], at[b]) += lin.hessianBlock(a, b);
     }
   }
 

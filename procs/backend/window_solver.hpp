@@ -2,9 +2,9 @@
 // and the PoseManifold, with a linear solver shaped like the window: each dynamic object's
 // chain of poses and pose changes (a "group") touches only itself and a few shared blocks (the
 // "separator": ego poses, landmarks, the prior's blocks). Every group is eliminated with its
-// own dense Cholesky (a Schur complement, as Ceres' SCHUR solvers do for single blocks), then
-// the separator is solved densely. The marginalization prior is dense over its blocks, so the
-// separator is a dense matrix anyway; no general sparse factorization is needed.
+// own block-banded Cholesky (a Schur complement, as Ceres' SCHUR solvers do for single blocks),
+// then the separator is solved densely. The marginalization prior is dense over its blocks, so
+// the separator is a dense matrix anyway; no general sparse factorization is needed.
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -49,52 +49,65 @@ class WindowSolver {
   std::optional<Matrix6> covariance(const double* block) const;
 
  private:
-  // In-place Cholesky of a banded symmetric positive definite matrix (lower factor).
-  struct BandedCholesky {
-    Eigen::MatrixXd L;
-    int n = 0, bw = 0;
-    bool compute(const Eigen::MatrixXd& A);
-    // Row-major right-hand sides: substitution works row by row.
-    using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-    void solveL(RowMatrix& B) const;   // B <- L^-1 B
-    void solveLt(RowMatrix& B) const;  // B <- L^-T B
+  // Cholesky factor of a symmetric positive definite matrix of 6x6 blocks that is zero beyond
+  // `w` blocks from the diagonal (a group is a chain in time: o_f and c_f interleaved couple
+  // only to their neighbours), kept as its band of lower 6x6 blocks.
+  struct BandCholesky {
+    int m = 0, w = 0;
+    std::vector<Matrix6> L;  // L(i, i - d) at [i * (w + 1) + d]
+    std::vector<Matrix6> L_inv;  // L(i, i)^-1: substitution by products (6x6 solves are slow)
+    Matrix6& at(int i, int d) { return L[i * (w + 1) + d]; }
+    const Matrix6& at(int i, int d) const { return L[i * (w + 1) + d]; }
+    // Factors the band `H` (same layout) damped by mu diag(H); false when not definite.
+    bool compute(const std::vector<Matrix6>& H, int m, int w, double mu);
+    void solveL(Eigen::MatrixXd& B) const;   // B <- L^-1 B (B: 6m rows)
+    void solveLt(Eigen::MatrixXd& B) const;  // B <- L^-T B
   };
   struct Group {
-    std::vector<double*> blocks;  // estimated ones
-    int n = 0;
-    Eigen::MatrixXd H, C;  // undamped; H: n x n; C: n x 6|touched|, coupling to the touched separator blocks
+    std::vector<double*> blocks;  // estimated ones, in time order
+    int m = 0, w = 0;             // blocks, block bandwidth
+    std::vector<Matrix6> H;       // undamped band (BandCholesky layout)
+    Eigen::MatrixXd C;            // 6m x 6|touched|: coupling to the touched separator blocks
     Eigen::VectorXd g;
-    std::vector<int> touched;  // separator block indices
-    std::unordered_map<int, int> column;  // separator block index -> column offset in C
-    BandedCholesky chol;
-    BandedCholesky::RowMatrix Y;  // L^-1 [C g]
+    std::vector<int> touched;     // separator block indices
+    BandCholesky chol;
+    Eigen::MatrixXd Y;            // L^-1 C
   };
-  struct Location {
-    int group = -1;  // -1: separator
-    int offset = 0;  // tangent offset in the separator or the group
-    int index = 0;   // separator block index (separator only)
+  // Where a factor's block lives: a separator block, a group's block, or nowhere (fixed).
+  struct Slot {
+    int group = -2;   // -1: separator, -2: fixed, else the group
+    int index = 0;    // block index in the separator or in the group
+    int column = -1;  // separator block of a group's factor: its column offset in the group's C
   };
 
   void setUp(const std::vector<double*>& separator, const std::vector<std::vector<double*>>& groups,
              const std::unordered_set<const double*>& fixed, int tail);
-  // Which separator blocks each group's factors touch (fixed for one solve).
-  void findCouplings(const std::vector<const Factor*>& factors);
-  // Linearizes every factor and assembles the undamped normal equations.
+  // Each factor's slots, the separator blocks each group touches and its bandwidth.
+  void mapFactors(const std::vector<const Factor*>& factors);
+  // Linearizes every factor and assembles the gradient.
   void linearizeAll(const std::vector<const Factor*>& factors, const std::unordered_set<const double*>& fixed);
-  // Solves the system damped by mu; false when a Cholesky fails.
-  bool solveStep(double mu, Eigen::VectorXd& step_sep, std::vector<Eigen::VectorXd>& step_groups);
-  double modelCostChange(const std::vector<const Factor*>& factors, const Eigen::VectorXd& step_sep,
-                         const std::vector<Eigen::VectorXd>& step_groups) const;
-  Eigen::VectorXd stepOf(const double* block, const Eigen::VectorXd& step_sep,
-                         const std::vector<Eigen::VectorXd>& step_groups) const;
+  // Assembles the undamped Gauss-Newton Hessian of the last linearization.
+  void assembleHessian();
+  // Factors the Hessian damped by mu: the groups' band Cholesky and Schur complements, then
+  // the separator's dense Cholesky. False when one fails.
+  bool factor(double mu);
+  // The step for the current gradient from the last factorization, into step_sep_ and
+  // step_groups_.
+  void substitute();
+  double modelCostChange() const;
+  Vector6 stepOf(const Slot& s) const;
 
   std::vector<double*> separator_;
   std::vector<Group> groups_;
-  std::unordered_map<const double*, Location> where_;
+  std::unordered_map<const double*, Slot> where_;
+  std::vector<std::vector<Slot>> slots_;  // per factor, per block
   int n_sep_ = 0, tail_dim_ = 0;
   std::vector<FactorLinearization> lin_;
   Eigen::MatrixXd H_sep_;  // undamped, before the groups' Schur complements
   Eigen::VectorXd g_sep_;
+  Eigen::MatrixXd H_reduced_;  // damped, after them (what sep_llt_ factors)
+  Eigen::VectorXd step_sep_;
+  std::vector<Eigen::VectorXd> step_groups_;
   double max_gradient_ = 0;
   Eigen::LLT<Eigen::MatrixXd> sep_llt_;
   Eigen::MatrixXd tail_cov_;  // joint covariance of the tail blocks

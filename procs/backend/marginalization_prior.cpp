@@ -48,17 +48,16 @@ void MarginalizationPrior::gradient(double const* const* x, std::vector<Matrix6>
   for (int i = 0; i < n; ++i) g.segment<6>(6 * i).noalias() = M[i].transpose() * g0.segment<6>(6 * i);
 }
 
-Matrix6 MarginalizationPrior::hessianBlock(const std::vector<Matrix6>& M, int i, int j) const {
-  return M[i].transpose() * JtJ_.block<6, 6>(6 * i, 6 * j) * M[j];
+void MarginalizationPrior::hessian(const std::vector<Matrix6>& M, Eigen::MatrixXd& H) const {
+  H = JtJ_;
+  for (int j = 0; j < numBlocks(); ++j) H.middleCols<6>(6 * j) = H.middleCols<6>(6 * j) * M[j];
+  for (int i = 0; i < numBlocks(); ++i) H.middleRows<6>(6 * i) = M[i].transpose() * H.middleRows<6>(6 * i);
 }
 
 void MarginalizationPrior::linearize(double const* const* x, Eigen::MatrixXd& H, Eigen::VectorXd& g) const {
   std::vector<Matrix6> M;
   gradient(x, M, g);
-  const int n = numBlocks();
-  H.resize(6 * n, 6 * n);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) H.block<6, 6>(6 * i, 6 * j) = hessianBlock(M, i, j);
+  hessian(M, H);
 }
 
 double MarginalizationPrior::curvature(const std::vector<Matrix6>& M, const Eigen::VectorXd& dx) const {

@@ -27,10 +27,10 @@ class MarginalizationPrior final : public ceres::CostFunction {
 
   // The Gauss-Newton terms at x in the blocks' tangent spaces, without forming Jx^T Jx from the
   // dense rows: Jx = J blockdiag(M) with M_i = d(x_i [-] x_lin_i)/dx_i, so the gradient is
-  // g = M^T (J^T r0 + J^T J dx) and the Hessian's blocks M_i^T (J^T J)_ij M_j (hessianBlock),
-  // formed only where a solver needs them. J^T J and J^T r0 are kept from construction.
+  // g = M^T (J^T r0 + J^T J dx) and the Hessian blockdiag(M)^T (J^T J) blockdiag(M), formed
+  // only when a solver needs it. J^T J and J^T r0 are kept from construction.
   void gradient(double const* const* x, std::vector<Matrix6>& M, Eigen::VectorXd& g) const;
-  Matrix6 hessianBlock(const std::vector<Matrix6>& M, int i, int j) const;
+  void hessian(const std::vector<Matrix6>& M, Eigen::MatrixXd& H) const;
   // The whole H = Jx^T Jx and g = Jx^T r(x) (for tests and small priors).
   void linearize(double const* const* x, Eigen::MatrixXd& H, Eigen::VectorXd& g) const;
   // |Jx dx|^2 for a tangent step dx over every block.

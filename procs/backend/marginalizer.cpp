@@ -1,10 +1,10 @@
 #include "backend/marginalizer.hpp"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <unordered_map>
 
+#include "backend/dense_kernels.hpp"
 #include "backend/factor_linearization.hpp"
 #include "backend/se3.hpp"
 #include "backend/marginalization_prior.hpp"
@@ -13,66 +13,41 @@ namespace dlslot::backend {
 namespace {
 
 // H* = H_rr - H_rm H_mm^-1 H_mr and g* = g_r - H_rm H_mm^-1 g_m for the first nm rows/columns
-// leaving. With H_mm = L L^T and Y = L^-1 [H_mr g_m]: H* = H_rr - Y^T Y. A kept block is
-// coupled to few leaving ones (an object's next pose to its last one), so its columns of H_mr,
-// and of Y, are zero above the first leaving block it is coupled to: solve and multiply only
-// below it. A singular H_mm (a direction no factor constrains, which carries no information to
-// pass on) falls back to the pseudo-inverse.
+// leaving. With H_mm = L L^T and Y = L^-1 H_mr: H* = H_rr - Y^T Y and g* = g_r - Y^T L^-1 g_m.
+// A singular H_mm (a direction no factor constrains, which carries no information to pass on)
+// falls back to the pseudo-inverse.
 void schurComplement(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int nm, Eigen::MatrixXd& H_star,
                      Eigen::VectorXd& g_star) {
   const int nr = static_cast<int>(H.rows()) - nm;
   H_star = H.bottomRightCorner(nr, nr);
   g_star = g.tail(nr);
-  Eigen::LLT<Eigen::MatrixXd> llt(H.topLeftCorner(nm, nm));
-  if (llt.info() != Eigen::Success) {
+  Eigen::MatrixXd L = H.topLeftCorner(nm, nm);
+  Eigen::MatrixXd Y = H.topRightCorner(nm, nr);
+  Eigen::VectorXd z = g.head(nm);
+  if (dense::cholesky(L)) {
+    dense::solveLower(L, Y);
+    dense::solveLower(L, z);
+  } else {
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H.topLeftCorner(nm, nm));
     const double eps = 1e-10 * std::max(1.0, es.eigenvalues().cwiseAbs().maxCoeff());
     const Eigen::VectorXd inv_sqrt =
         (es.eigenvalues().array() > eps).select(es.eigenvalues().cwiseMax(eps).cwiseSqrt().cwiseInverse(), 0.0);
-    Eigen::MatrixXd Y(nm, nr + 1);
-    Y << H.topRightCorner(nm, nr), g.head(nm);
     Y = inv_sqrt.asDiagonal() * (es.eigenvectors().transpose() * Y);
-    H_star.noalias() -= Y.leftCols(nr).transpose() * Y.leftCols(nr);
-    g_star.noalias() -= Y.leftCols(nr).transpose() * Y.col(nr);
-    return;
+    z = inv_sqrt.asDiagonal() * (es.eigenvectors().transpose() * z);
   }
-  const Eigen::MatrixXd& L = llt.matrixLLT();  // L in the lower triangle
-  const int kept = nr / 6;
-  std::vector<int> first(kept, nm);  // first row of each kept block's columns that is not zero
-  for (int c = 0; c < kept; ++c)
-    for (int row = 0; row < nm; row += 6)
-      if (!H.block<6, 6>(row, nm + 6 * c).isZero(0.0)) {
-        first[c] = row;
-        break;
-      }
-  Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(nm, nr);
-  for (int c = 0; c < kept; ++c) {
-    const int p = first[c], rows = nm - p;
-    if (rows == 0) continue;
-    Y.block(p, 6 * c, rows, 6) = H.block(p, nm + 6 * c, rows, 6);
-    L.block(p, p, rows, rows).triangularView<Eigen::Lower>().solveInPlace(Y.block(p, 6 * c, rows, 6));
-  }
-  const Eigen::VectorXd yg = L.triangularView<Eigen::Lower>().solve(g.head(nm));
-  for (int a = 0; a < kept; ++a) {
-    if (first[a] == nm) continue;
-    g_star.segment<6>(6 * a).noalias() -= Y.block(first[a], 6 * a, nm - first[a], 6).transpose() * yg.tail(nm - first[a]);
-    for (int b = 0; b <= a; ++b) {
-      const int p = std::max(first[a], first[b]);
-      if (p == nm) continue;
-      const Matrix6 S = Y.block(p, 6 * a, nm - p, 6).transpose() * Y.block(p, 6 * b, nm - p, 6);
-      H_star.block<6, 6>(6 * a, 6 * b) -= S;
-      if (b != a) H_star.block<6, 6>(6 * b, 6 * a) -= S.transpose();
-    }
-  }
+  dense::subtractGram(Y, H_star);
+  H_star = H_star.selfadjointView<Eigen::Lower>();
+  g_star.noalias() -= Y.transpose() * z;
 }
 
 // H = J^T J and g = J^T r  ->  (J, r); J is upper triangular when H is definite (returns
 // true), else the eigen-decomposition without the null space (returns false).
 bool factorize(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, Eigen::MatrixXd& J, Eigen::VectorXd& r) {
-  Eigen::LLT<Eigen::MatrixXd> llt(H);
-  if (llt.info() == Eigen::Success) {
-    J = llt.matrixU();
-    r = llt.matrixL().solve(g);
+  Eigen::MatrixXd L = H;
+  if (dense::cholesky(L)) {
+    J = L.triangularView<Eigen::Lower>().transpose();
+    r = g;
+    dense::solveLower(L, r);
     return true;
   }
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H);
@@ -115,16 +90,18 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(nm + nr, nm + nr);
   Eigen::VectorXd g = Eigen::VectorXd::Zero(nm + nr);
   FactorLinearization lin;
+  Eigen::MatrixXd Hf;
   for (const Factor* f : factors) {
     const int nb = static_cast<int>(f->blocks.size());
     std::vector<int> at(nb);
     for (int k = 0; k < nb; ++k) at[k] = fixed.count(f->blocks[k]) ? -1 : 6 * index.at(f->blocks[k]);
     linearize(*f, fixed, lin);
+    lin.hessian(Hf);
     for (int a = 0; a < nb; ++a) {
       if (at[a] < 0) continue;
       g.segment<6>(at[a]) += lin.gradientBlock(a);
       for (int b = 0; b < nb; ++b)
-        if (at[b] >= 0) H.block<6, 6>(at[a], at[b]) += lin.hessianBlock(a, b);
+        if (at[b] >= 0) H.block<6, 6>(at[a], at[b]) += Hf.block<6, 6>(6 * a, 6 * b);
     }
   }
 

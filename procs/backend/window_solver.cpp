@@ -5,6 +5,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "backend/dense_kernels.hpp"
 #include "backend/pose_manifold.hpp"
 
 namespace dlslot::backend {
@@ -44,22 +45,21 @@ bool WindowSolver::BandCholesky::compute(const std::vector<Matrix6>& H, int bloc
   return true;
 }
 
-void WindowSolver::BandCholesky::solveL(Eigen::MatrixXd& B) const {
+void WindowSolver::BandCholesky::solveL(RowMatrix& B, const std::vector<int>* widths) const {
   for (int i = 0; i < m; ++i) {
-    auto Bi = B.middleRows<6>(6 * i);
-    for (int k = std::max(0, i - w); k < i; ++k) Bi.noalias() -= at(i, i - k).lazyProduct(B.middleRows<6>(6 * k));
-    const Eigen::Matrix<double, 6, Eigen::Dynamic> t = L_inv[i].lazyProduct(Bi);
-    Bi = t;
+    const int n = widths ? (*widths)[i] : static_cast<int>(B.cols());
+    auto Bi = B.block(6 * i, 0, 6, n);
+    for (int k = std::max(0, i - w); k < i; ++k) Bi.noalias() -= at(i, i - k) * B.block(6 * k, 0, 6, n);
+    Bi = (L_inv[i] * Bi).eval();
   }
 }
 
-void WindowSolver::BandCholesky::solveLt(Eigen::MatrixXd& B) const {
+void WindowSolver::BandCholesky::solveLt(RowMatrix& B) const {
   for (int i = m - 1; i >= 0; --i) {
     auto Bi = B.middleRows<6>(6 * i);
     for (int k = i + 1; k <= std::min(m - 1, i + w); ++k)
-      Bi.noalias() -= at(k, k - i).transpose().lazyProduct(B.middleRows<6>(6 * k));
-    const Eigen::Matrix<double, 6, Eigen::Dynamic> t = L_inv[i].transpose().lazyProduct(Bi);
-    Bi = t;
+      Bi.noalias() -= at(k, k - i).transpose() * B.middleRows<6>(6 * k);
+    Bi = (L_inv[i].transpose() * Bi).eval();
   }
 }
 
@@ -122,10 +122,26 @@ void WindowSolver::mapFactors(const std::vector<const Factor*>& factors) {
     g.touched.assign(touched[k].begin(), touched[k].end());
     for (size_t a = 0; a < g.touched.size(); ++a) column[k][g.touched[a]] = 6 * static_cast<int>(a);
   }
+  // Each column's first non-zero block row, then the staircase's widths.
+  std::vector<std::vector<int>> first(groups_.size());
+  for (size_t k = 0; k < groups_.size(); ++k) first[k].assign(groups_[k].touched.size(), groups_[k].m);
   for (size_t i = 0; i < factors.size(); ++i) {
-    if (factor_group[i] < 0) continue;
-    for (Slot& s : slots_[i])
-      if (s.group == -1) s.column = column[factor_group[i]].at(s.index);
+    const int k = factor_group[i];
+    if (k < 0) continue;
+    int row = groups_[k].m;
+    for (const Slot& s : slots_[i])
+      if (s.group == k) row = std::min(row, s.index);
+    for (Slot& s : slots_[i]) {
+      if (s.group != -1) continue;
+      s.column = column[k].at(s.index);
+      first[k][s.column / 6] = std::min(first[k][s.column / 6], row);
+    }
+  }
+  for (size_t k = 0; k < groups_.size(); ++k) {
+    Group& g = groups_[k];
+    g.widths.assign(g.m, 0);
+    for (size_t a = 0; a < g.touched.size(); ++a)
+      for (int row = first[k][a]; row < g.m; ++row) g.widths[row] = std::max(g.widths[row], 6 * static_cast<int>(a) + 6);
   }
 }
 
@@ -154,8 +170,9 @@ void WindowSolver::assembleHessian() {
     g.H.assign(g.m * (g.w + 1), Matrix6::Zero());
     g.C.setZero(6 * g.m, 6 * static_cast<int>(g.touched.size()));
   }
+  Eigen::MatrixXd Hf;
   for (size_t i = 0; i < lin_.size(); ++i) {
-    const FactorLinearization& lin = lin_[i];
+    lin_[i].hessian(Hf);
     const std::vector<Slot>& slots = slots_[i];
     const int nb = static_cast<int>(slots.size());
     for (int a = 0; a < nb; ++a) {
@@ -163,14 +180,15 @@ void WindowSolver::assembleHessian() {
       if (sa.group == -2) continue;
       for (int b = 0; b < nb; ++b) {
         const Slot& sb = slots[b];
+        const auto block = Hf.block<6, 6>(6 * a, 6 * b);
         if (sb.group == -2) continue;
         if (sa.group == -1 && sb.group == -1) {
-          H_sep_.block<6, 6>(6 * sa.index, 6 * sb.index) += lin.hessianBlock(a, b);
+          H_sep_.block<6, 6>(6 * sa.index, 6 * sb.index) += block;
         } else if (sa.group >= 0 && sb.group == sa.group) {
           Group& g = groups_[sa.group];
-          if (sb.index <= sa.index) g.H[sa.index * (g.w + 1) + (sa.index - sb.index)] += lin.hessianBlock(a, b);
+          if (sb.index <= sa.index) g.H[sa.index * (g.w + 1) + (sa.index - sb.index)] += block;
         } else if (sa.group >= 0) {
-          groups_[sa.group].C.block<6, 6>(6 * sa.index, sb.column) += lin.hessianBlock(a, b);
+          groups_[sa.group].C.block<6, 6>(6 * sa.index, sb.column) += block;
         }  // (separator, group): the transpose of C; the band keeps the lower half
       }
     }
@@ -181,35 +199,26 @@ bool WindowSolver::factor(double mu) {
   H_reduced_ = H_sep_;
   damp(H_reduced_, mu);
   // Each group's Schur complement: with H_k = L L^T and Y = L^-1 C, the separator keeps
-  // H - Y^T Y.
+  // H - Y^T Y (over the separator blocks the group touches).
   for (Group& grp : groups_) {
     if (!grp.chol.compute(grp.H, grp.m, grp.w, mu)) return false;
     const int nc = static_cast<int>(grp.C.cols());
     grp.Y = grp.C;
-    grp.chol.solveL(grp.Y);
+    grp.chol.solveL(grp.Y, &grp.widths);
     Eigen::MatrixXd S = Eigen::MatrixXd::Zero(nc, nc);
-    S.selfadjointView<Eigen::Lower>().rankUpdate(grp.Y.transpose());
-    for (size_t a = 0; a < grp.touched.size(); ++a) {
-      const int ra = 6 * grp.touched[a];
-      for (size_t b = 0; b <= a; ++b) {
-        const int rb = 6 * grp.touched[b];
-        const Matrix6 Sab = S.block<6, 6>(6 * a, 6 * b);
-        H_reduced_.block<6, 6>(ra, rb) -= Sab;
-        if (b != a) H_reduced_.block<6, 6>(rb, ra) -= Sab.transpose();
-      }
-    }
+    dense::subtractGram(grp.Y, S);
+    S = S.selfadjointView<Eigen::Lower>();
+    for (size_t a = 0; a < grp.touched.size(); ++a)
+      for (size_t b = 0; b < grp.touched.size(); ++b)
+        H_reduced_.block<6, 6>(6 * grp.touched[a], 6 * grp.touched[b]) += S.block<6, 6>(6 * a, 6 * b);
   }
-  if (n_sep_ > 0) {
-    sep_llt_.compute(H_reduced_);
-    if (sep_llt_.info() != Eigen::Success) return false;
-  }
-  return true;
+  return n_sep_ == 0 || dense::cholesky(H_reduced_);
 }
 
 void WindowSolver::substitute() {
   // The separator's gradient after the groups' elimination: g - Y^T z with z = L^-1 g_k.
   Eigen::VectorXd g = g_sep_;
-  std::vector<Eigen::MatrixXd> z(groups_.size());
+  std::vector<RowMatrix> z(groups_.size());
   for (size_t k = 0; k < groups_.size(); ++k) {
     const Group& grp = groups_[k];
     z[k] = grp.g;
@@ -217,15 +226,18 @@ void WindowSolver::substitute() {
     const Eigen::VectorXd s = grp.Y.transpose() * z[k];
     for (size_t a = 0; a < grp.touched.size(); ++a) g.segment<6>(6 * grp.touched[a]) -= s.segment<6>(6 * a);
   }
-  step_sep_.resize(n_sep_);
-  if (n_sep_ > 0) step_sep_ = -sep_llt_.solve(g);
+  if (n_sep_ > 0) {
+    dense::solveLower(H_reduced_, g);
+    dense::solveLowerTransposed(H_reduced_, g);
+  }
+  step_sep_ = -g;
   // Back-substitution: x_k = -H_k^-1 (g_k + C d) = -L^-T (z + Y d), d the separator's step.
   step_groups_.resize(groups_.size());
   for (size_t k = 0; k < groups_.size(); ++k) {
     const Group& grp = groups_[k];
     Eigen::VectorXd d(grp.Y.cols());
     for (size_t a = 0; a < grp.touched.size(); ++a) d.segment<6>(6 * a) = step_sep_.segment<6>(6 * grp.touched[a]);
-    Eigen::MatrixXd& x = z[k];
+    RowMatrix& x = z[k];
     x.noalias() += grp.Y * d;
     grp.chol.solveLt(x);
     step_groups_[k] = -x;
@@ -326,7 +338,7 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
     assembleHessian();
     if (!factor(1e-12)) return summary;
   }
-  const Eigen::MatrixXd L_tail = sep_llt_.matrixLLT().bottomRightCorner(tail_dim_, tail_dim_);
+  const Eigen::MatrixXd L_tail = H_reduced_.bottomRightCorner(tail_dim_, tail_dim_);
   Eigen::MatrixXd L_inv = Eigen::MatrixXd::Identity(tail_dim_, tail_dim_);
   L_tail.triangularView<Eigen::Lower>().solveInPlace(L_inv);
   tail_cov_ = L_inv.transpose() * L_inv;  // (L_tail L_tail^T)^-1: the trailing blocks' marginal
@@ -345,12 +357,12 @@ std::optional<Matrix6> WindowSolver::covariance(const double* block) const {
   // Group block: Sigma = [H_k^-1]_bb + W Sigma_tail W^T with W = [H_k^-1 C_k]_b over the
   // tail blocks the group touches.
   const Group& g = groups_[s.group];
-  auto solve = [&g](Eigen::MatrixXd B) {
+  auto solve = [&g](RowMatrix B) {
     g.chol.solveL(B);
     g.chol.solveLt(B);
     return B;
   };
-  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(6 * g.m, 6);
+  RowMatrix E = RowMatrix::Zero(6 * g.m, 6);
   E.middleRows<6>(6 * s.index).setIdentity();
   Matrix6 cov = solve(E).middleRows<6>(6 * s.index);
   std::vector<int> cols, tail_offsets;
@@ -360,7 +372,7 @@ std::optional<Matrix6> WindowSolver::covariance(const double* block) const {
       tail_offsets.push_back(6 * g.touched[a] - tail_start);
     }
   if (cols.empty()) return cov;
-  Eigen::MatrixXd C(6 * g.m, 6 * cols.size());
+  RowMatrix C(6 * g.m, 6 * cols.size());
   Eigen::MatrixXd Sigma(6 * cols.size(), 6 * cols.size());
   for (size_t a = 0; a < cols.size(); ++a) {
     C.middleCols<6>(6 * a) = g.C.middleCols<6>(cols[a]);

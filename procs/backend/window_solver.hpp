@@ -7,12 +7,13 @@
 // the separator is a dense matrix anyway; no general sparse factorization is needed.
 #pragma once
 
-#include <Eigen/Cholesky>
+#include <Eigen/Core>
 #include <optional>
 #include <unordered_map>
 #include <unordered_set>
 #include <vector>
 
+#include "backend/dense_kernels.hpp"
 #include "backend/factor.hpp"
 #include "backend/factor_linearization.hpp"
 #include "backend/se3.hpp"
@@ -49,6 +50,8 @@ class WindowSolver {
   std::optional<Matrix6> covariance(const double* block) const;
 
  private:
+  // Row-major: the substitutions below work on rows of 6x6 blocks.
+  using RowMatrix = dense::RowMatrix;
   // Cholesky factor of a symmetric positive definite matrix of 6x6 blocks that is zero beyond
   // `w` blocks from the diagonal (a group is a chain in time: o_f and c_f interleaved couple
   // only to their neighbours), kept as its band of lower 6x6 blocks.
@@ -60,8 +63,10 @@ class WindowSolver {
     const Matrix6& at(int i, int d) const { return L[i * (w + 1) + d]; }
     // Factors the band `H` (same layout) damped by mu diag(H); false when not definite.
     bool compute(const std::vector<Matrix6>& H, int m, int w, double mu);
-    void solveL(Eigen::MatrixXd& B) const;   // B <- L^-1 B (B: 6m rows)
-    void solveLt(Eigen::MatrixXd& B) const;  // B <- L^-T B
+    // B <- L^-1 B (B: 6m rows). With `widths`, row block i of B is zero beyond widths[i]
+    // columns (widths growing with i; C's staircase) and only those are touched.
+    void solveL(RowMatrix& B, const std::vector<int>* widths = nullptr) const;
+    void solveLt(RowMatrix& B) const;  // B <- L^-T B
   };
   struct Group {
     std::vector<double*> blocks;  // estimated ones, in time order
@@ -70,8 +75,11 @@ class WindowSolver {
     Eigen::MatrixXd C;            // 6m x 6|touched|: coupling to the touched separator blocks
     Eigen::VectorXd g;
     std::vector<int> touched;     // separator block indices
+    // Columns of C that can be non-zero in each block row: an ego pose X_f couples to the
+    // chain from o_f on, so C (and Y) are a staircase when the touched blocks come in time order.
+    std::vector<int> widths;
     BandCholesky chol;
-    Eigen::MatrixXd Y;            // L^-1 C
+    RowMatrix Y;                  // L^-1 C
   };
   // Where a factor's block lives: a separator block, a group's block, or nowhere (fixed).
   struct Slot {
@@ -105,11 +113,11 @@ class WindowSolver {
   std::vector<FactorLinearization> lin_;
   Eigen::MatrixXd H_sep_;  // undamped, before the groups' Schur complements
   Eigen::VectorXd g_sep_;
-  Eigen::MatrixXd H_reduced_;  // damped, after them (what sep_llt_ factors)
+  // Damped, after them; factor() leaves the separator's Cholesky factor in its lower triangle.
+  Eigen::MatrixXd H_reduced_;
   Eigen::VectorXd step_sep_;
   std::vector<Eigen::VectorXd> step_groups_;
   double max_gradient_ = 0;
-  Eigen::LLT<Eigen::MatrixXd> sep_llt_;
   Eigen::MatrixXd tail_cov_;  // joint covariance of the tail blocks
 };
 

@@ -42,12 +42,12 @@ inline void solveLowerTransposed(ConstMatrixRef L, MatrixRef B) {
                             static_cast<int>(B.cols()), static_cast<int>(B.outerStride()));
 }
 // S <- S - Y^T Y on S's lower triangle.
-inline void subtractGram(const Eigen::MatrixXd& Y, MatrixRef S) {
+inline void subtractGram(ConstMatrixRef Y, MatrixRef S) {
   raw::subtractGram(Y.data(), static_cast<int>(Y.rows()), static_cast<int>(Y.cols()), static_cast<int>(Y.outerStride()),
                     S.data(), static_cast<int>(S.outerStride()));
 }
-// The same for a row-major Y (whose storage is Y^T column-major).
-inline void subtractGram(const RowMatrix& Y, MatrixRef S) {
+// subtractGram for a row-major Y (whose storage is Y^T column-major).
+inline void subtractGramRows(const RowMatrix& Y, MatrixRef S) {
   raw::subtractOuter(Y.data(), static_cast<int>(Y.cols()), static_cast<int>(Y.rows()), static_cast<int>(Y.cols()),
                      S.data(), static_cast<int>(S.outerStride()));
 }

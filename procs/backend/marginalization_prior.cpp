@@ -49,9 +49,12 @@ void MarginalizationPrior::gradient(double const* const* x, std::vector<Matrix6>
 }
 
 void MarginalizationPrior::hessian(const std::vector<Matrix6>& M, Eigen::MatrixXd& H) const {
+  // M_i = blockdiag(I, R_i) (minusJacobianAt): only the rotation columns and rows change.
   H = JtJ_;
-  for (int j = 0; j < numBlocks(); ++j) H.middleCols<6>(6 * j) = H.middleCols<6>(6 * j) * M[j];
-  for (int i = 0; i < numBlocks(); ++i) H.middleRows<6>(6 * i) = M[i].transpose() * H.middleRows<6>(6 * i);
+  for (int j = 0; j < numBlocks(); ++j)
+    H.middleCols<3>(6 * j + 3) = (H.middleCols<3>(6 * j + 3) * M[j].bottomRightCorner<3, 3>()).eval();
+  for (int i = 0; i < numBlocks(); ++i)
+    H.middleRows<3>(6 * i + 3) = (M[i].bottomRightCorner<3, 3>().transpose() * H.middleRows<3>(6 * i + 3)).eval();
 }
 
 void MarginalizationPrior::linearize(double const* const* x, Eigen::MatrixXd& H, Eigen::VectorXd& g) const {

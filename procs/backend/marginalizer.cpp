@@ -1,6 +1,7 @@
 #include "backend/marginalizer.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <unordered_map>
 
@@ -14,18 +15,25 @@ namespace {
 
 // H* = H_rr - H_rm H_mm^-1 H_mr and g* = g_r - H_rm H_mm^-1 g_m for the first nm rows/columns
 // leaving. With H_mm = L L^T and Y = L^-1 H_mr: H* = H_rr - Y^T Y and g* = g_r - Y^T L^-1 g_m.
-// A singular H_mm (a direction no factor constrains, which carries no information to pass on)
-// falls back to the pseudo-inverse.
-void schurComplement(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int nm, Eigen::MatrixXd& H_star,
-                     Eigen::VectorXd& g_star) {
+// Kept block c's column of H_mr is zero above first_row[c] (non-decreasing), so is Y's: each
+// group of columns is solved with the trailing part of L only, and Y^T Y is summed over bands
+// of rows, each with the columns that are non-zero there. A singular H_mm (a direction no
+// factor constrains, which carries no information to pass on) falls back to the pseudo-inverse.
+void schurComplement(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int nm, std::vector<int> first_row,
+                     Eigen::MatrixXd& H_star, Eigen::VectorXd& g_star) {
   const int nr = static_cast<int>(H.rows()) - nm;
   H_star = H.bottomRightCorner(nr, nr);
   g_star = g.tail(nr);
   Eigen::MatrixXd L = H.topLeftCorner(nm, nm);
   Eigen::MatrixXd Y = H.topRightCorner(nm, nr);
   Eigen::VectorXd z = g.head(nm);
+  const int kept = nr / 6;
   if (dense::cholesky(L)) {
-    dense::solveLower(L, Y);
+    for (int c0 = 0, c1 = 0; c0 < kept; c0 = c1) {
+      const int p = first_row[c0];
+      while (c1 < kept && first_row[c1] == p) ++c1;
+      if (p < nm) dense::solveLower(L.bottomRightCorner(nm - p, nm - p), Y.block(p, 6 * c0, nm - p, 6 * (c1 - c0)));
+    }
     dense::solveLower(L, z);
   } else {
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H.topLeftCorner(nm, nm));
@@ -34,8 +42,15 @@ void schurComplement(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int nm,
         (es.eigenvalues().array() > eps).select(es.eigenvalues().cwiseMax(eps).cwiseSqrt().cwiseInverse(), 0.0);
     Y = inv_sqrt.asDiagonal() * (es.eigenvectors().transpose() * Y);
     z = inv_sqrt.asDiagonal() * (es.eigenvectors().transpose() * z);
+    first_row.assign(kept, 0);  // Y is full now
   }
-  dense::subtractGram(Y, H_star);
+  // Rows [p, next p) are non-zero in the columns of the blocks with first_row <= p only.
+  for (int c = 0; c < kept && first_row[c] < nm;) {
+    const int p = first_row[c];
+    while (c < kept && first_row[c] == p) ++c;
+    const int end = c < kept ? std::min(first_row[c], nm) : nm;
+    dense::subtractGram(Y.block(p, 0, end - p, 6 * c), H_star.topLeftCorner(6 * c, 6 * c));
+  }
   H_star = H_star.selfadjointView<Eigen::Lower>();
   g_star.noalias() -= Y.transpose() * z;
 }
@@ -66,18 +81,39 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
                                                 const std::unordered_set<const double*>& fixed) {
   stats_ = Stats();
   stats_.factors = static_cast<int>(factors.size());
-  // Order the estimated blocks: leaving ones first, then the ones that stay.
-  std::vector<double*> order, kept;
+  // Order the estimated blocks: leaving ones first, then the ones that stay, sorted by the
+  // first leaving block they share a factor with (first_row; none: after all). A kept block is
+  // coupled to few leaving ones (an object's next pose and change to its last ones), so its
+  // columns of H_mr, and of L^-1 H_mr, are zero above that row: a staircase the Schur
+  // complement exploits.
+  std::vector<double*> order;
   std::unordered_map<const double*, int> index;
-  for (int pass = 0; pass < 2; ++pass) {
-    for (const Factor* f : factors) {
-      for (double* b : f->blocks) {
-        if (fixed.count(b) || index.count(b) || (leaving.count(b) > 0) != (pass == 0)) continue;
+  for (const Factor* f : factors)
+    for (double* b : f->blocks)
+      if (!fixed.count(b) && leaving.count(b) && !index.count(b)) {
         index[b] = static_cast<int>(order.size());
         order.push_back(b);
-        if (pass == 1) kept.push_back(b);
       }
+  const int n_leaving = static_cast<int>(order.size());
+  std::unordered_map<double*, int> first_block;  // kept block -> first leaving block index
+  std::vector<double*> kept;
+  for (const Factor* f : factors) {
+    int first = n_leaving;
+    for (double* b : f->blocks)
+      if (index.count(b)) first = std::min(first, index.at(b));
+    for (double* b : f->blocks) {
+      if (fixed.count(b) || leaving.count(b)) continue;
+      auto [it, is_new] = first_block.emplace(b, first);
+      if (is_new) kept.push_back(b);
+      it->second = std::min(it->second, first);
     }
+  }
+  std::stable_sort(kept.begin(), kept.end(), [&](double* a, double* b) { return first_block[a] < first_block[b]; });
+  std::vector<int> first_row;
+  for (double* b : kept) {
+    index[b] = static_cast<int>(order.size());
+    order.push_back(b);
+    first_row.push_back(6 * first_block[b]);
   }
   const int n = static_cast<int>(order.size());
   const int nm = 6 * (n - static_cast<int>(kept.size()));
@@ -108,7 +144,7 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
   // Schur complement onto the kept blocks.
   Eigen::MatrixXd H_star = H.bottomRightCorner(nr, nr);
   Eigen::VectorXd g_star = g.tail(nr);
-  if (nm > 0) schurComplement(H, g, nm, H_star, g_star);
+  if (nm > 0) schurComplement(H, g, nm, first_row, H_star, g_star);
 
   // A kept block the eliminated factors say nothing about (e.g. the second pose of an object
   // whose first one leaves: the pose change used up what its observation said) gets no prior.

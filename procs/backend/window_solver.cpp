@@ -206,7 +206,7 @@ bool WindowSolver::factor(double mu) {
     grp.Y = grp.C;
     grp.chol.solveL(grp.Y, &grp.widths);
     Eigen::MatrixXd S = Eigen::MatrixXd::Zero(nc, nc);
-    dense::subtractGram(grp.Y, S);
+    dense::subtractGramRows(grp.Y, S);
     S = S.selfadjointView<Eigen::Lower>();
     for (size_t a = 0; a < grp.touched.size(); ++a)
       for (size_t b = 0; b < grp.touched.size(); ++b)

@@ -4,7 +4,7 @@
 #include <stdexcept>
 
 #include "backend/marginalization_prior.hpp"
-#include "backend/pose_manifold.hpp"
+#include "backend/pose_factor.hpp"
 
 namespace dlslot::backend {
 namespace {
@@ -40,21 +40,15 @@ void linearize(const Factor& f, const std::unordered_set<const double*>& fixed, 
       if (!lin.estimated[k]) lin.g.segment<6>(6 * k).setZero();
     return;
   }
-  if (f.cost->num_residuals() != 6) throw std::logic_error("linearize: expected a 6-dimensional residual");
-  if (nb > 3) throw std::logic_error("linearize: expected at most 3 blocks");
-  Matrix67 J_amb[3];
-  double* jac[3] = {nullptr, nullptr, nullptr};
-  for (int k = 0; k < nb; ++k)
-    if (lin.estimated[k]) jac[k] = J_amb[k].data();
-  f.cost->Evaluate(f.blocks.data(), lin.r.data(), jac);
+  const auto* factor = dynamic_cast<const PoseFactor*>(f.cost.get());
+  if (!factor) throw std::logic_error("linearize: expected a PoseFactor or a MarginalizationPrior");
   lin.J.resize(nb);
+  Matrix6* J[PoseFactor::kMaxBlocks] = {nullptr, nullptr, nullptr};
   for (int k = 0; k < nb; ++k) {
-    if (lin.estimated[k]) {
-      lin.J[k].noalias() = J_amb[k] * PoseManifold::plusJacobian(f.blocks[k]);
-    } else {
-      lin.J[k].setZero();
-    }
+    lin.J[k].setZero();
+    if (lin.estimated[k]) J[k] = &lin.J[k];
   }
+  lin.r = factor->evaluate(f.blocks.data(), J);
   if (f.loss) applyLoss(*f.loss, lin);
 }
 

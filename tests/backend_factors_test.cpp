@@ -9,6 +9,7 @@
 
 #include "backend/backend_config.hpp"
 #include "backend/constant_velocity_factor.hpp"
+#include "backend/dense_kernels.hpp"
 #include "backend/landmark_observation_factor.hpp"
 #include "backend/marginalization_prior.hpp"
 #include "backend/marginalizer.hpp"
@@ -330,6 +331,86 @@ TEST(BackendMarginalizer, SchurComplementOfTheLinearizedSystem) {
   const Eigen::VectorXd expected_g = g.tail(12) - Hmr.transpose() * Hmm.inverse() * g.head(6);
   EXPECT_TRUE(Hr.isApprox(expected_H, 1e-8));
   EXPECT_TRUE(gr.isApprox(expected_g, 1e-8));
+}
+
+// Several leaving blocks, each kept block coupled to a different one (a staircase in L^-1 H_mr,
+// which the Marginalizer exploits), under a dense prior: still exactly the Schur complement.
+TEST(BackendMarginalizer, StaircaseSchurComplementUnderADensePrior) {
+  std::mt19937 rng(12);
+  std::vector<Vector7> blocks;
+  for (int i = 0; i < 8; ++i) blocks.push_back(toBlock(randomPose(rng)));
+  std::vector<Factor> factors;
+  auto add = [&](ceres::CostFunction* c, std::vector<int> b) {
+    std::vector<double*> ptrs;
+    for (int i : b) ptrs.push_back(blocks[i].data());
+    factors.push_back({std::shared_ptr<ceres::CostFunction>(c), nullptr, ptrs});
+  };
+  // A dense prior over blocks 0-3 (they leave), then chains 0->4, 1->5, 2->6, 3->7.
+  std::vector<Vector7> x_lin(blocks.begin(), blocks.begin() + 4);
+  const Eigen::MatrixXd J = Eigen::MatrixXd::Random(24, 24) + 5.0 * Eigen::MatrixXd::Identity(24, 24);
+  factors.push_back({std::make_shared<MarginalizationPrior>(x_lin, J, Eigen::VectorXd::Random(24)), nullptr,
+                     {blocks[0].data(), blocks[1].data(), blocks[2].data(), blocks[3].data()}});
+  for (int i = 0; i < 4; ++i) add(OdometryFactor::Create(error(rng), randomSqrtInfo(rng)), {i, i + 4});
+  add(PoseChangeFactor::Create(randomSqrtInfo(rng)), {2, 6, 5});
+  std::vector<const Factor*> all;
+  for (const Factor& f : factors) all.push_back(&f);
+  Marginalizer marginalizer;
+  const auto full = marginalizer.marginalize(all, {}, {});
+  const auto reduced =
+      marginalizer.marginalize(all, {blocks[0].data(), blocks[1].data(), blocks[2].data(), blocks[3].data()}, {});
+  ASSERT_TRUE(full && reduced);
+  EXPECT_EQ(marginalizer.lastStats().leaving_dim, 24);
+  Eigen::MatrixXd H, Hr;
+  Eigen::VectorXd g, gr;
+  dynamic_cast<const MarginalizationPrior&>(*full->cost).linearize(full->blocks.data(), H, g);
+  dynamic_cast<const MarginalizationPrior&>(*reduced->cost).linearize(reduced->blocks.data(), Hr, gr);
+  // Expected, in full's block order, then permuted to reduced's.
+  std::vector<int> m, r;
+  for (int k = 0; k < static_cast<int>(full->blocks.size()); ++k)
+    for (int d = 0; d < 6; ++d) (full->blocks[k] < blocks[4].data() ? m : r).push_back(6 * k + d);
+  const Eigen::MatrixXd Hmm = H(m, m), Hmr = H(m, r);
+  const Eigen::MatrixXd expected_H = H(r, r) - Hmr.transpose() * Hmm.inverse() * Hmr;
+  const Eigen::VectorXd expected_g = g(r) - Hmr.transpose() * Hmm.inverse() * g(m);
+  std::vector<int> perm;  // reduced block k -> its rows in expected_*
+  for (double* b : reduced->blocks) {
+    int pos = 0;
+    for (int k = 0; k < static_cast<int>(full->blocks.size()); ++k)
+      if (!(full->blocks[k] < blocks[4].data())) {
+        if (full->blocks[k] == b) break;
+        ++pos;
+      }
+    for (int d = 0; d < 6; ++d) perm.push_back(6 * pos + d);
+  }
+  EXPECT_TRUE(Hr.isApprox(expected_H(perm, perm), 1e-8));
+  EXPECT_TRUE(gr.isApprox(expected_g(perm), 1e-8));
+}
+
+// The CPU-specific kernels against Eigen's own algorithms.
+TEST(BackendDenseKernels, MatchEigen) {
+  const int n = 37, m = 5;
+  const Eigen::MatrixXd R = Eigen::MatrixXd::Random(n, n);
+  const Eigen::MatrixXd A = R * R.transpose() + n * Eigen::MatrixXd::Identity(n, n);
+  Eigen::MatrixXd L = A;
+  ASSERT_TRUE(dense::cholesky(L));
+  const Eigen::MatrixXd L_ref = A.llt().matrixL();
+  EXPECT_TRUE(Eigen::MatrixXd(L.triangularView<Eigen::Lower>()).isApprox(L_ref, 1e-12));
+  Eigen::MatrixXd not_definite = -A;
+  EXPECT_FALSE(dense::cholesky(not_definite));
+  const Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, m);
+  Eigen::MatrixXd X = B;
+  dense::solveLower(L, X);
+  EXPECT_TRUE((L_ref * X).isApprox(B, 1e-12));
+  X = B;
+  dense::solveLowerTransposed(L, X);
+  EXPECT_TRUE((L_ref.transpose() * X).isApprox(B, 1e-12));
+  const Eigen::MatrixXd Y = Eigen::MatrixXd::Random(9, n);
+  Eigen::MatrixXd S = A;
+  dense::subtractGram(Y, S);
+  const Eigen::MatrixXd expected = A - Y.transpose() * Y;
+  EXPECT_TRUE(Eigen::MatrixXd(S.triangularView<Eigen::Lower>()).isApprox(Eigen::MatrixXd(expected.triangularView<Eigen::Lower>()), 1e-12));
+  S = A;
+  dense::subtractGramRows(dense::RowMatrix(Y), S);
+  EXPECT_TRUE(Eigen::MatrixXd(S.triangularView<Eigen::Lower>()).isApprox(Eigen::MatrixXd(expected.triangularView<Eigen::Lower>()), 1e-12));
 }
 
 TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {

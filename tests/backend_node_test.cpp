@@ -77,27 +77,12 @@ void writeLog(const std::string& path, const std::vector<BackendInput>& inputs) 
   }
 }
 
-SimScene replayScene() {
-  SimScene s;
-  s.ego = constantTwist(Pose::Identity(), 10.0, 0.05);
-  s.odometry_noise << 0.02, 0.02, 0.01, 0.002, 0.002, 0.003;
-  s.box_noise << 0.1, 0.1, 0.05;
-  SimObject parked, moving;
-  parked.id = 1;
-  parked.pose = [](double) { return planarPose(20, 6, 0.2); };
-  moving.id = 2;
-  moving.pose = constantTwist(planarPose(10, -3.5, 0), 12.0, 0.05);
-  s.objects = {parked, moving};
-  s.frames_without_odometry = {7};
-  s.frames_without_associations = {9};
-  return s;
-}
 
 }  // namespace
 
 TEST(BackendNode, OfflineReplayWritesSlotState) {
   const std::string dir = scratchDir();
-  const SimScene scene = replayScene();
+  const SimScene scene = parkedAndMovingScene(7, 9);
   const auto inputs = scene.generate(25);
   writeLog(dir + "/in.lcmlog", inputs);
   for (const std::string mode : {"slot", "two-stage", "odometry-only"}) {

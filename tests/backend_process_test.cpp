@@ -29,18 +29,7 @@ TEST(BackendProcess, LiveFramesWithMissingInputs) {
   const std::string cfg_path = dir + "/dlslot.yaml";
   std::ofstream(cfg_path) << cfg;
 
-  SimScene scene;
-  scene.ego = constantTwist(Pose::Identity(), 10.0, 0.05);
-  scene.odometry_noise << 0.02, 0.02, 0.01, 0.002, 0.002, 0.003;
-  scene.box_noise << 0.1, 0.1, 0.05;
-  SimObject parked, moving;
-  parked.id = 1;
-  parked.pose = [](double) { return planarPose(20, 6, 0.2); };
-  moving.id = 2;
-  moving.pose = constantTwist(planarPose(10, -3.5, 0), 12.0, 0.05);
-  scene.objects = {parked, moving};
-  scene.frames_without_odometry = {5};
-  scene.frames_without_associations = {8};
+  const SimScene scene = parkedAndMovingScene(5, 8);
   const auto inputs = scene.generate(14);
 
   lcm::LCM lcm;

@@ -132,4 +132,22 @@ struct SimScene {
   }
 };
 
+// The small scene of the node and process tests: driving at 10 m/s past one parked car with one
+// car moving ahead, odometry and associations missing at the given frames.
+inline SimScene parkedAndMovingScene(int frame_without_odometry, int frame_without_associations) {
+  SimScene s;
+  s.ego = constantTwist(Pose::Identity(), 10.0, 0.05);
+  s.odometry_noise << 0.02, 0.02, 0.01, 0.002, 0.002, 0.003;
+  s.box_noise << 0.1, 0.1, 0.05;
+  SimObject parked, moving;
+  parked.id = 1;
+  parked.pose = [](double) { return planarPose(20, 6, 0.2); };
+  moving.id = 2;
+  moving.pose = constantTwist(planarPose(10, -3.5, 0), 12.0, 0.05);
+  s.objects = {parked, moving};
+  s.frames_without_odometry = {frame_without_odometry};
+  s.frames_without_associations = {frame_without_associations};
+  return s;
+}
+
 }  // namespace dlslot::backend::test

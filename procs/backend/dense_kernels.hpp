@@ -1,7 +1,7 @@
 // The few dense kernels that take most of the window's time: the separator's Cholesky (the
 // marginalization prior makes it dense), the Gram updates of the objects' Schur complements,
 // and the marginalization's triangular solves. They are compiled for this machine's CPU
-// (-march=native: AVX/FMA run them about 3x faster than the x86-64 baseline) in a shared
+// (-march=native: AVX/FMA vector units the x86-64 baseline lacks) in a shared
 // library of their own whose symbols are hidden but for these functions: Eigen's code inside,
 // and every allocation it makes, never mix with the rest of the program's Eigen, which is
 // built for any x86-64 like the Ceres, PCL and OpenCV it links (mixing them corrupts the heap).

@@ -45,8 +45,11 @@ void linearize(const Factor& f, const std::unordered_set<const double*>& fixed, 
   lin.J.resize(nb);
   Matrix6* J[PoseFactor::kMaxBlocks] = {nullptr, nullptr, nullptr};
   for (int k = 0; k < nb; ++k) {
-    lin.J[k].setZero();
-    if (lin.estimated[k]) J[k] = &lin.J[k];
+    if (lin.estimated[k]) {
+      J[k] = &lin.J[k];
+    } else {
+      lin.J[k].setZero();  // a fixed block has no tangent
+    }
   }
   lin.r = factor->evaluate(f.blocks.data(), J);
   if (f.loss) applyLoss(*f.loss, lin);

@@ -85,6 +85,8 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   s.get("gradient_tolerance", c.gradient_tolerance);
   s.get("parameter_tolerance", c.parameter_tolerance);
   s.get("compute_covariance", c.compute_covariance);
+  s.get("solver_threads", c.solver_threads);
+  require(c.solver_threads >= 1, s, "solver_threads", "an integer >= 1");
   return c;
 }
 

@@ -61,6 +61,9 @@ struct BackendConfig {
   double parameter_tolerance = 1e-8;
   // Marginal covariances of the newest ego pose and the tracks (WindowSolver::covariance).
   bool compute_covariance = true;
+  // Threads for the objects' eliminations and the factors' linearizations (the caller's
+  // included); the estimate is the same for any number.
+  int solver_threads = 2;
 
   // Reads every key above from `section` (not finish(): the node reads its own keys too).
   static BackendConfig read(ConfigSection& section);

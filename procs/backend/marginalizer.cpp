@@ -9,39 +9,54 @@
 #include "backend/factor_linearization.hpp"
 #include "backend/se3.hpp"
 #include "backend/marginalization_prior.hpp"
+#include "backend/parallel_for.hpp"
 
 namespace dlslot::backend {
 namespace {
 
-// H* = H_rr - H_rm H_mm^-1 H_mr and g* = g_r - H_rm H_mm^-1 g_m for the first nm rows/columns
-// leaving. With H_mm = L L^T and Y = L^-1 H_mr: H* = H_rr - Y^T Y and g* = g_r - Y^T L^-1 g_m.
+// H* = H_rr - H_rm H_mm^-1 H_mr and g* = g_r - H_rm H_mm^-1 g_m, in place: on entry H_mm,
+// H_mr, H_rr (lower triangle) and g_m, g_r; on exit H_rr holds H* and g_r holds g*, the others
+// are used up. With H_mm = L L^T and Y = L^-1 H_mr: H* = H_rr - Y^T Y, g* = g_r - Y^T L^-1 g_m.
 // Kept block c's column of H_mr is zero above first_row[c] (non-decreasing), so is Y's: each
-// group of columns is solved with the trailing part of L only, and Y^T Y is summed over bands
-// of rows, each with the columns that are non-zero there. A singular H_mm (a direction no
-// factor constrains, which carries no information to pass on) falls back to the pseudo-inverse.
-void schurComplement(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int nm, std::vector<int> first_row,
-                     Eigen::MatrixXd& H_star, Eigen::VectorXd& g_star) {
-  const int nr = static_cast<int>(H.rows()) - nm;
-  H_star = H.bottomRightCorner(nr, nr);
-  g_star = g.tail(nr);
-  Eigen::MatrixXd L = H.topLeftCorner(nm, nm);
-  Eigen::MatrixXd Y = H.topRightCorner(nm, nr);
-  Eigen::VectorXd z = g.head(nm);
-  const int kept = nr / 6;
+// group of columns is solved with the trailing part of L only (the groups in parallel), and
+// Y^T Y is summed over bands of rows, each with the columns that are non-zero there. A
+// singular H_mm (a direction no factor constrains, which carries no information to pass on)
+// falls back to the pseudo-inverse.
+void schurComplement(Eigen::MatrixXd& H_mm, Eigen::MatrixXd& H_mr, Eigen::MatrixXd& H_rr, Eigen::VectorXd& g_m,
+                     Eigen::VectorXd& g_r, std::vector<int> first_row, ParallelFor* parallel) {
+  const int nm = static_cast<int>(H_mm.rows()), kept = static_cast<int>(H_rr.rows()) / 6;
+  Eigen::MatrixXd& L = H_mm;
+  Eigen::MatrixXd& Y = H_mr;
+  const Eigen::VectorXd diagonal = H_mm.diagonal();
   if (dense::cholesky(L)) {
+    std::vector<std::pair<int, int>> column_groups;  // [c0, c1): blocks with the same first row
     for (int c0 = 0, c1 = 0; c0 < kept; c0 = c1) {
-      const int p = first_row[c0];
-      while (c1 < kept && first_row[c1] == p) ++c1;
-      if (p < nm) dense::solveLower(L.bottomRightCorner(nm - p, nm - p), Y.block(p, 6 * c0, nm - p, 6 * (c1 - c0)));
+      while (c1 < kept && first_row[c1] == first_row[c0]) ++c1;
+      if (first_row[c0] < nm) column_groups.emplace_back(c0, c1);
     }
-    dense::solveLower(L, z);
+    auto solve = [&](int k) {
+      const auto [c0, c1] = column_groups[k];
+      const int p = first_row[c0];
+      dense::solveLower(L.bottomRightCorner(nm - p, nm - p), Y.block(p, 6 * c0, nm - p, 6 * (c1 - c0)));
+    };
+    const int groups = static_cast<int>(column_groups.size());
+    if (parallel) {
+      (*parallel)(groups, solve);
+    } else {
+      for (int k = 0; k < groups; ++k) solve(k);
+    }
+    dense::solveLower(L, g_m);
   } else {
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H.topLeftCorner(nm, nm));
+    // The Cholesky left the upper triangle alone: H_mm is still there, but for its diagonal.
+    // (The eigen solver reads the lower triangle.)
+    Eigen::MatrixXd H = H_mm.transpose();
+    H.diagonal() = diagonal;
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H);
     const double eps = 1e-10 * std::max(1.0, es.eigenvalues().cwiseAbs().maxCoeff());
     const Eigen::VectorXd inv_sqrt =
         (es.eigenvalues().array() > eps).select(es.eigenvalues().cwiseMax(eps).cwiseSqrt().cwiseInverse(), 0.0);
     Y = inv_sqrt.asDiagonal() * (es.eigenvectors().transpose() * Y);
-    z = inv_sqrt.asDiagonal() * (es.eigenvectors().transpose() * z);
+    g_m = inv_sqrt.asDiagonal() * (es.eigenvectors().transpose() * g_m);
     first_row.assign(kept, 0);  // Y is full now
   }
   // Rows [p, next p) are non-zero in the columns of the blocks with first_row <= p only.
@@ -49,10 +64,9 @@ void schurComplement(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, int nm,
     const int p = first_row[c];
     while (c < kept && first_row[c] == p) ++c;
     const int end = c < kept ? std::min(first_row[c], nm) : nm;
-    dense::subtractGram(Y.block(p, 0, end - p, 6 * c), H_star.topLeftCorner(6 * c, 6 * c));
+    dense::subtractGram(Y.block(p, 0, end - p, 6 * c), H_rr.topLeftCorner(6 * c, 6 * c));
   }
-  H_star = H_star.selfadjointView<Eigen::Lower>();
-  g_star.noalias() -= Y.transpose() * z;
+  g_r.noalias() -= Y.transpose() * g_m;
 }
 
 // H = J^T J and g = J^T r  ->  (J, r); J is upper triangular when H is definite (returns
@@ -122,29 +136,48 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
   stats_.kept_dim = nr;
   if (nr == 0) return std::nullopt;
 
-  // Linearize every factor at the current estimate into the dense H, g.
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(nm + nr, nm + nr);
-  Eigen::VectorXd g = Eigen::VectorXd::Zero(nm + nr);
-  FactorLinearization lin;
-  Eigen::MatrixXd Hf;
-  for (const Factor* f : factors) {
+  // Linearize every factor at the current estimate (in parallel), then sum into the blocks
+  // H_mm, H_mr, H_rr (lower triangle) and g_m, g_r of the dense H, g.
+  std::vector<FactorLinearization> lin(factors.size());
+  std::vector<Eigen::MatrixXd> Hf(factors.size());
+  auto linearizeFactor = [&](int i) {
+    linearize(*factors[i], fixed, lin[i]);
+    lin[i].hessian(Hf[i]);
+  };
+  const int nf = static_cast<int>(factors.size());
+  if (parallel_) {
+    (*parallel_)(nf, linearizeFactor);
+  } else {
+    for (int i = 0; i < nf; ++i) linearizeFactor(i);
+  }
+  Eigen::MatrixXd H_mm = Eigen::MatrixXd::Zero(nm, nm), H_mr = Eigen::MatrixXd::Zero(nm, nr);
+  Eigen::MatrixXd H_star = Eigen::MatrixXd::Zero(nr, nr);
+  Eigen::VectorXd g_m = Eigen::VectorXd::Zero(nm), g_star = Eigen::VectorXd::Zero(nr);
+  for (int i = 0; i < nf; ++i) {
+    const Factor* f = factors[i];
     const int nb = static_cast<int>(f->blocks.size());
     std::vector<int> at(nb);
     for (int k = 0; k < nb; ++k) at[k] = fixed.count(f->blocks[k]) ? -1 : 6 * index.at(f->blocks[k]);
-    linearize(*f, fixed, lin);
-    lin.hessian(Hf);
     for (int a = 0; a < nb; ++a) {
       if (at[a] < 0) continue;
-      g.segment<6>(at[a]) += lin.gradientBlock(a);
-      for (int b = 0; b < nb; ++b)
-        if (at[b] >= 0) H.block<6, 6>(at[a], at[b]) += Hf.block<6, 6>(6 * a, 6 * b);
+      (at[a] < nm ? g_m.segment<6>(at[a]) : g_star.segment<6>(at[a] - nm)) += lin[i].gradientBlock(a);
+      for (int b = 0; b < nb; ++b) {
+        if (at[b] < 0) continue;
+        const auto block = Hf[i].block<6, 6>(6 * a, 6 * b);
+        if (at[a] < nm && at[b] < nm) {
+          H_mm.block<6, 6>(at[a], at[b]) += block;
+        } else if (at[a] < nm) {
+          H_mr.block<6, 6>(at[a], at[b] - nm) += block;
+        } else if (at[b] >= nm && at[b] <= at[a]) {
+          H_star.block<6, 6>(at[a] - nm, at[b] - nm) += block;
+        }  // (kept, leaving): the transpose of H_mr; H_rr keeps its lower triangle
+      }
     }
   }
 
   // Schur complement onto the kept blocks.
-  Eigen::MatrixXd H_star = H.bottomRightCorner(nr, nr);
-  Eigen::VectorXd g_star = g.tail(nr);
-  if (nm > 0) schurComplement(H, g, nm, first_row, H_star, g_star);
+  if (nm > 0) schurComplement(H_mm, H_mr, H_star, g_m, g_star, first_row, parallel_);
+  H_star = H_star.selfadjointView<Eigen::Lower>();
 
   // A kept block the eliminated factors say nothing about (e.g. the second pose of an object
   // whose first one leaves: the pose change used up what its observation said) gets no prior.

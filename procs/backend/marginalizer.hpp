@@ -13,8 +13,14 @@
 
 namespace dlslot::backend {
 
+class ParallelFor;
+
 class Marginalizer {
  public:
+  // The factors' linearizations and the elimination's solves run on `parallel`'s threads when
+  // given; the prior does not depend on their number.
+  explicit Marginalizer(ParallelFor* parallel = nullptr) : parallel_(parallel) {}
+
   struct Stats {
     int leaving_dim = 0;  // tangent dimension eliminated
     int kept_dim = 0;     // tangent dimension of the new prior
@@ -30,6 +36,7 @@ class Marginalizer {
   const Stats& lastStats() const { return stats_; }
 
  private:
+  ParallelFor* parallel_;
   Stats stats_;
 };
 

@@ -44,7 +44,10 @@ Pose power(const Pose& c, int n) {
 }  // namespace
 
 SlidingWindow::SlidingWindow(BackendConfig config)
-    : config_(std::move(config)), observation_loss_(makeLoss(config_.observation_loss, config_.observation_loss_scale)) {}
+    : config_(std::move(config)),
+      parallel_(config_.solver_threads),
+      marginalizer_(&parallel_),
+      observation_loss_(makeLoss(config_.observation_loss, config_.observation_loss_scale)) {}
 
 SlidingWindow::~SlidingWindow() = default;
 
@@ -271,7 +274,7 @@ void SlidingWindow::solve(BackendOutput& out) {
   so.gradient_tolerance = config_.gradient_tolerance;
   so.parameter_tolerance = config_.parameter_tolerance;
   so.covariance = config_.compute_covariance;
-  const auto summary = solver_.solve(factors, separator, groups, fixed_, static_cast<int>(tail.size()), so);
+  const auto summary = solver_.solve(factors, separator, groups, fixed_, static_cast<int>(tail.size()), so, &parallel_);
   out.stats.iterations = summary.iterations;
   out.stats.initial_cost = summary.initial_cost;
   out.stats.final_cost = summary.final_cost;

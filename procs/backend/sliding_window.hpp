@@ -94,6 +94,7 @@ class SlidingWindow {
   std::vector<double*> liveBlocks() const;
 
   BackendConfig config_;
+  ParallelFor parallel_;
   Marginalizer marginalizer_;
   WindowSolver solver_;
   std::shared_ptr<ceres::LossFunction> observation_loss_;

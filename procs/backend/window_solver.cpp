@@ -12,10 +12,7 @@ namespace dlslot::backend {
 namespace {
 
 // Levenberg-Marquardt damping as Ceres applies it: H + mu diag(H), the diagonal clamped.
-template <typename M>
-void damp(M& H, double mu) {
-  for (Eigen::Index i = 0; i < H.rows(); ++i) H(i, i) += mu * std::clamp(H(i, i), 1e-6, 1e32);
-}
+double damping(double diagonal, double mu) { return mu * std::clamp(diagonal, 1e-6, 1e32); }
 
 }  // namespace
 
@@ -35,7 +32,7 @@ bool WindowSolver::BandCholesky::compute(const std::vector<Matrix6>& H, int bloc
         at(i, d).noalias() = S * L_inv[j].transpose();
         continue;
       }
-      damp(S, mu);
+      for (int r = 0; r < 6; ++r) S(r, r) += damping(S(r, r), mu);
       Eigen::LLT<Matrix6> llt(S);
       if (llt.info() != Eigen::Success) return false;
       at(i, 0) = llt.matrixL();
@@ -92,6 +89,7 @@ void WindowSolver::setUp(const std::vector<double*>& separator, const std::vecto
 void WindowSolver::mapFactors(const std::vector<const Factor*>& factors) {
   std::vector<std::set<int>> touched(groups_.size());
   std::vector<int> factor_group(factors.size(), -1);
+  separator_factors_.clear();
   slots_.resize(factors.size());
   for (size_t i = 0; i < factors.size(); ++i) {
     const Factor& f = *factors[i];
@@ -107,8 +105,12 @@ void WindowSolver::mapFactors(const std::vector<const Factor*>& factors) {
       group = it->second.group;
     }
     factor_group[i] = group;
-    if (group < 0) continue;
+    if (group < 0) {
+      separator_factors_.push_back(static_cast<int>(i));
+      continue;
+    }
     Group& g = groups_[group];
+    g.factors.push_back(static_cast<int>(i));
     for (const Slot& a : slots) {
       if (a.group == -1) touched[group].insert(a.index);
       for (const Slot& b : slots)
@@ -145,87 +147,126 @@ void WindowSolver::mapFactors(const std::vector<const Factor*>& factors) {
   }
 }
 
+void WindowSolver::forEachItem(const std::function<void(int)>& work) {
+  const int items = static_cast<int>(groups_.size()) + 1;
+  if (parallel_) {
+    (*parallel_)(items, work);
+  } else {
+    for (int i = 0; i < items; ++i) work(i);
+  }
+}
+
 void WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
                                 const std::unordered_set<const double*>& fixed) {
-  g_sep_.setZero(n_sep_);
-  for (Group& g : groups_) g.g.setZero(6 * g.m);
   lin_.resize(factors.size());
-  for (size_t i = 0; i < factors.size(); ++i) {
-    FactorLinearization& lin = lin_[i];
-    linearize(*factors[i], fixed, lin);
-    const std::vector<Slot>& slots = slots_[i];
-    for (size_t a = 0; a < slots.size(); ++a) {
-      const Slot& s = slots[a];
-      if (s.group == -2) continue;
-      (s.group >= 0 ? groups_[s.group].g : g_sep_).segment<6>(6 * s.index) += lin.gradientBlock(static_cast<int>(a));
+  forEachItem([&](int item) {
+    Eigen::MatrixXd Hf;
+    if (item == 0) {
+      g_sep_.setZero(n_sep_);
+      H_sep_.setZero(n_sep_, n_sep_);
+    } else {
+      Group& g = groups_[item - 1];
+      const int nc = 6 * static_cast<int>(g.touched.size());
+      g.g.setZero(6 * g.m);
+      g.g_touched.setZero(nc);
+      g.H.assign(g.m * (g.w + 1), Matrix6::Zero());
+      g.C.setZero(6 * g.m, nc);
+      g.D.setZero(nc, nc);
     }
-  }
+    for (int i : itemFactors(item)) {
+      FactorLinearization& lin = lin_[i];
+      linearize(*factors[i], fixed, lin);
+      lin.hessian(Hf);
+      const std::vector<Slot>& slots = slots_[i];
+      const int nb = static_cast<int>(slots.size());
+      for (int a = 0; a < nb; ++a) {
+        const Slot& sa = slots[a];
+        if (sa.group == -2) continue;
+        if (item == 0) {
+          g_sep_.segment<6>(6 * sa.index) += lin.gradientBlock(a);
+          for (int b = 0; b < nb; ++b)
+            if (slots[b].group == -1) H_sep_.block<6, 6>(6 * sa.index, 6 * slots[b].index) += Hf.block<6, 6>(6 * a, 6 * b);
+          continue;
+        }
+        Group& g = groups_[item - 1];
+        if (sa.group >= 0) {
+          g.g.segment<6>(6 * sa.index) += lin.gradientBlock(a);
+        } else {
+          g.g_touched.segment<6>(sa.column) += lin.gradientBlock(a);
+        }
+        for (int b = 0; b < nb; ++b) {
+          const Slot& sb = slots[b];
+          const auto block = Hf.block<6, 6>(6 * a, 6 * b);
+          if (sb.group == -2) continue;
+          if (sa.group >= 0 && sb.group >= 0) {
+            if (sb.index <= sa.index) g.H[sa.index * (g.w + 1) + (sa.index - sb.index)] += block;
+          } else if (sa.group >= 0) {
+            g.C.block<6, 6>(6 * sa.index, sb.column) += block;
+          } else if (sb.group == -1 && sb.column <= sa.column) {
+            g.D.block<6, 6>(sa.column, sb.column) += block;
+          }  // (separator, group): the transpose of C; the band and D keep lower halves
+        }
+      }
+    }
+  });
+  diag_sep_ = H_sep_.diagonal();
+  for (const Group& g : groups_)
+    for (size_t a = 0; a < g.touched.size(); ++a) {
+      g_sep_.segment<6>(6 * g.touched[a]) += g.g_touched.segment<6>(6 * a);
+      diag_sep_.segment<6>(6 * g.touched[a]) += g.D.diagonal().segment<6>(6 * a);
+    }
   max_gradient_ = n_sep_ > 0 ? g_sep_.cwiseAbs().maxCoeff() : 0.0;
   for (const Group& g : groups_) max_gradient_ = std::max(max_gradient_, g.g.cwiseAbs().maxCoeff());
 }
 
-void WindowSolver::assembleHessian() {
-  H_sep_.setZero(n_sep_, n_sep_);
-  for (Group& g : groups_) {
-    g.H.assign(g.m * (g.w + 1), Matrix6::Zero());
-    g.C.setZero(6 * g.m, 6 * static_cast<int>(g.touched.size()));
-  }
-  Eigen::MatrixXd Hf;
-  for (size_t i = 0; i < lin_.size(); ++i) {
-    lin_[i].hessian(Hf);
-    const std::vector<Slot>& slots = slots_[i];
-    const int nb = static_cast<int>(slots.size());
-    for (int a = 0; a < nb; ++a) {
-      const Slot& sa = slots[a];
-      if (sa.group == -2) continue;
-      for (int b = 0; b < nb; ++b) {
-        const Slot& sb = slots[b];
-        const auto block = Hf.block<6, 6>(6 * a, 6 * b);
-        if (sb.group == -2) continue;
-        if (sa.group == -1 && sb.group == -1) {
-          H_sep_.block<6, 6>(6 * sa.index, 6 * sb.index) += block;
-        } else if (sa.group >= 0 && sb.group == sa.group) {
-          Group& g = groups_[sa.group];
-          if (sb.index <= sa.index) g.H[sa.index * (g.w + 1) + (sa.index - sb.index)] += block;
-        } else if (sa.group >= 0) {
-          groups_[sa.group].C.block<6, 6>(6 * sa.index, sb.column) += block;
-        }  // (separator, group): the transpose of C; the band keeps the lower half
-      }
-    }
-  }
+double WindowSolver::totalCost(const std::vector<const Factor*>& factors) {
+  item_sums_.assign(groups_.size() + 1, 0.0);
+  forEachItem([&](int item) {
+    for (int i : itemFactors(item)) item_sums_[item] += factorCost(*factors[i]);
+  });
+  double cost = 0;
+  for (double c : item_sums_) cost += c;
+  return cost;
 }
 
 bool WindowSolver::factor(double mu) {
-  H_reduced_ = H_sep_;
-  damp(H_reduced_, mu);
   // Each group's Schur complement: with H_k = L L^T and Y = L^-1 C, the separator keeps
-  // H - Y^T Y (over the separator blocks the group touches).
-  for (Group& grp : groups_) {
-    if (!grp.chol.compute(grp.H, grp.m, grp.w, mu)) return false;
-    const int nc = static_cast<int>(grp.C.cols());
+  // D - Y^T Y over the blocks the group touches.
+  std::vector<char> ok(groups_.size());
+  forEachItem([&](int item) {
+    if (item == 0) return;
+    Group& grp = groups_[item - 1];
+    ok[item - 1] = grp.chol.compute(grp.H, grp.m, grp.w, mu);
+    if (!ok[item - 1]) return;
     grp.Y = grp.C;
     grp.chol.solveL(grp.Y, &grp.widths);
-    Eigen::MatrixXd S = Eigen::MatrixXd::Zero(nc, nc);
-    dense::subtractGramRows(grp.Y, S);
-    S = S.selfadjointView<Eigen::Lower>();
+    grp.S = grp.D;
+    dense::subtractGramRows(grp.Y, grp.S);
+  });
+  if (std::find(ok.begin(), ok.end(), 0) != ok.end()) return false;
+  // Lower triangles only: touched is in separator order, so S's lower blocks land in
+  // H_reduced_'s lower triangle, the only one the Cholesky reads.
+  H_reduced_ = H_sep_;
+  for (const Group& grp : groups_)
     for (size_t a = 0; a < grp.touched.size(); ++a)
-      for (size_t b = 0; b < grp.touched.size(); ++b)
-        H_reduced_.block<6, 6>(6 * grp.touched[a], 6 * grp.touched[b]) += S.block<6, 6>(6 * a, 6 * b);
-  }
+      for (size_t b = 0; b <= a; ++b)
+        H_reduced_.block<6, 6>(6 * grp.touched[a], 6 * grp.touched[b]) += grp.S.block<6, 6>(6 * a, 6 * b);
+  for (int i = 0; i < n_sep_; ++i) H_reduced_(i, i) += damping(diag_sep_(i), mu);
   return n_sep_ == 0 || dense::cholesky(H_reduced_);
 }
 
 void WindowSolver::substitute() {
   // The separator's gradient after the groups' elimination: g - Y^T z with z = L^-1 g_k.
+  forEachItem([&](int item) {
+    if (item == 0) return;
+    Group& grp = groups_[item - 1];
+    grp.z = grp.g;
+    grp.chol.solveL(grp.z);
+    grp.Ytz.noalias() = grp.Y.transpose() * grp.z;
+  });
   Eigen::VectorXd g = g_sep_;
-  std::vector<RowMatrix> z(groups_.size());
-  for (size_t k = 0; k < groups_.size(); ++k) {
-    const Group& grp = groups_[k];
-    z[k] = grp.g;
-    grp.chol.solveL(z[k]);
-    const Eigen::VectorXd s = grp.Y.transpose() * z[k];
-    for (size_t a = 0; a < grp.touched.size(); ++a) g.segment<6>(6 * grp.touched[a]) -= s.segment<6>(6 * a);
-  }
+  for (const Group& grp : groups_)
+    for (size_t a = 0; a < grp.touched.size(); ++a) g.segment<6>(6 * grp.touched[a]) -= grp.Ytz.segment<6>(6 * a);
   if (n_sep_ > 0) {
     dense::solveLower(H_reduced_, g);
     dense::solveLowerTransposed(H_reduced_, g);
@@ -233,15 +274,15 @@ void WindowSolver::substitute() {
   step_sep_ = -g;
   // Back-substitution: x_k = -H_k^-1 (g_k + C d) = -L^-T (z + Y d), d the separator's step.
   step_groups_.resize(groups_.size());
-  for (size_t k = 0; k < groups_.size(); ++k) {
-    const Group& grp = groups_[k];
+  forEachItem([&](int item) {
+    if (item == 0) return;
+    Group& grp = groups_[item - 1];
     Eigen::VectorXd d(grp.Y.cols());
     for (size_t a = 0; a < grp.touched.size(); ++a) d.segment<6>(6 * a) = step_sep_.segment<6>(6 * grp.touched[a]);
-    RowMatrix& x = z[k];
-    x.noalias() += grp.Y * d;
-    grp.chol.solveLt(x);
-    step_groups_[k] = -x;
-  }
+    grp.z.noalias() += grp.Y * d;
+    grp.chol.solveLt(grp.z);
+    step_groups_[item - 1] = -grp.z;
+  });
 }
 
 Vector6 WindowSolver::stepOf(const Slot& s) const {
@@ -249,15 +290,19 @@ Vector6 WindowSolver::stepOf(const Slot& s) const {
   return s.group < 0 ? Vector6(step_sep_.segment<6>(6 * s.index)) : Vector6(step_groups_[s.group].segment<6>(6 * s.index));
 }
 
-double WindowSolver::modelCostChange() const {
+double WindowSolver::modelCostChange() {
   // cost - 0.5 |r + J dx|^2 summed over the factors (the linear model's predicted decrease).
+  item_sums_.assign(groups_.size() + 1, 0.0);
+  forEachItem([&](int item) {
+    std::vector<Vector6> dx;
+    for (int i : itemFactors(item)) {
+      dx.clear();
+      for (const Slot& s : slots_[i]) dx.push_back(stepOf(s));
+      item_sums_[item] += lin_[i].modelDecrease(dx);
+    }
+  });
   double change = 0;
-  std::vector<Vector6> dx;
-  for (size_t i = 0; i < lin_.size(); ++i) {
-    dx.clear();
-    for (const Slot& s : slots_[i]) dx.push_back(stepOf(s));
-    change += lin_[i].modelDecrease(dx);
-  }
+  for (double c : item_sums_) change += c;
   return change;
 }
 
@@ -265,16 +310,12 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
                                           const std::vector<double*>& separator,
                                           const std::vector<std::vector<double*>>& groups,
                                           const std::unordered_set<const double*>& fixed, int tail,
-                                          const Options& options) {
+                                          const Options& options, ParallelFor* parallel) {
+  parallel_ = parallel && parallel->threads() > 1 ? parallel : nullptr;
   setUp(separator, groups, fixed, tail);
   mapFactors(factors);
-  auto totalCost = [&] {
-    double c = 0;
-    for (const Factor* f : factors) c += factorCost(*f);
-    return c;
-  };
   Summary summary;
-  double cost = summary.initial_cost = totalCost();
+  double cost = summary.initial_cost = totalCost(factors);
   summary.final_cost = cost;
   if (where_.empty()) return summary;
 
@@ -291,7 +332,6 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
   for (int it = 0; it < options.max_iterations; ++it) {
     if (max_gradient_ <= options.gradient_tolerance) break;
     ++summary.iterations;
-    assembleHessian();
     if (!factor(1.0 / radius)) {
       radius /= decrease_factor;
       decrease_factor *= 2;
@@ -311,7 +351,7 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
       const Vector6 d = stepOf(estimated[i].second);
       manifold.Plus(saved[i].data(), d.data(), estimated[i].first);
     }
-    const double new_cost = totalCost();
+    const double new_cost = totalCost(factors);
     const double rho = (cost - new_cost) / model_change;
     if (model_change > 0 && rho > 1e-3) {
       radius = radius / std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
@@ -335,7 +375,6 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
   // was damped more than rounding (the tiny mu only guards against it).
   if (factored_mu < 0 || factored_mu > 1e-7) {
     linearizeAll(factors, fixed);
-    assembleHessian();
     if (!factor(1e-12)) return summary;
   }
   const Eigen::MatrixXd L_tail = H_reduced_.bottomRightCorner(tail_dim_, tail_dim_);

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <optional>
 #include <unordered_map>
 #include <unordered_set>
@@ -16,6 +17,7 @@
 #include "backend/dense_kernels.hpp"
 #include "backend/factor.hpp"
 #include "backend/factor_linearization.hpp"
+#include "backend/parallel_for.hpp"
 #include "backend/se3.hpp"
 
 namespace dlslot::backend {
@@ -40,9 +42,11 @@ class WindowSolver {
   // Minimizes the factors' cost over every block in `separator` and `groups` not in `fixed`.
   // No factor may touch two groups, and a MarginalizationPrior only separator blocks. The last
   // `tail` separator blocks get joint marginal covariances (see covariance()).
+  // The groups' work (linearization, elimination, substitution) is spread over `parallel`'s
+  // threads when given; the result does not depend on their number.
   Summary solve(const std::vector<const Factor*>& factors, const std::vector<double*>& separator,
                 const std::vector<std::vector<double*>>& groups, const std::unordered_set<const double*>& fixed,
-                int tail, const Options& options);
+                int tail, const Options& options, ParallelFor* parallel = nullptr);
 
   // Marginal covariance in the PoseManifold's tangent, from the last linearization: exact for
   // the separator's tail blocks; for a group block, exact when every separator block the group
@@ -68,18 +72,26 @@ class WindowSolver {
     void solveL(RowMatrix& B, const std::vector<int>* widths = nullptr) const;
     void solveLt(RowMatrix& B) const;  // B <- L^-T B
   };
+  // A group is self-contained: its factors (those touching its blocks) are linearized into
+  // its own band, coupling C and the part of the separator's Hessian (D) and gradient (g_touched)
+  // they contribute, so groups can be worked on in parallel.
   struct Group {
     std::vector<double*> blocks;  // estimated ones, in time order
+    std::vector<int> factors;     // indices of the factors touching them
     int m = 0, w = 0;             // blocks, block bandwidth
     std::vector<Matrix6> H;       // undamped band (BandCholesky layout)
-    Eigen::MatrixXd C;            // 6m x 6|touched|: coupling to the touched separator blocks
-    Eigen::VectorXd g;
+    RowMatrix C;                  // 6m x 6|touched|: coupling to the touched separator blocks
+    Eigen::MatrixXd D;            // the factors' Hessian among the touched blocks (lower blocks)
+    Eigen::VectorXd g, g_touched;  // gradient on the group's blocks and on the touched ones
     std::vector<int> touched;     // separator block indices
     // Columns of C that can be non-zero in each block row: an ego pose X_f couples to the
     // chain from o_f on, so C (and Y) are a staircase when the touched blocks come in time order.
     std::vector<int> widths;
     BandCholesky chol;
     RowMatrix Y;                  // L^-1 C
+    Eigen::MatrixXd S;            // D - Y^T Y: the group's Schur complement on the separator
+    RowMatrix z;                  // substitute(): L^-1 g, then the step
+    Eigen::VectorXd Ytz;          // substitute(): Y^T z
   };
   // Where a factor's block lives: a separator block, a group's block, or nowhere (fixed).
   struct Slot {
@@ -90,29 +102,38 @@ class WindowSolver {
 
   void setUp(const std::vector<double*>& separator, const std::vector<std::vector<double*>>& groups,
              const std::unordered_set<const double*>& fixed, int tail);
-  // Each factor's slots, the separator blocks each group touches and its bandwidth.
+  // Each factor's slots and group, the separator blocks each group touches and its bandwidth.
   void mapFactors(const std::vector<const Factor*>& factors);
-  // Linearizes every factor and assembles the gradient.
+  // Calls work(i) for each item: 0 the separator's own factors, k + 1 group k.
+  void forEachItem(const std::function<void(int)>& work);
+  const std::vector<int>& itemFactors(int item) const {
+    return item == 0 ? separator_factors_ : groups_[item - 1].factors;
+  }
+  // Linearizes every factor, assembles the gradient and the undamped Gauss-Newton Hessian.
   void linearizeAll(const std::vector<const Factor*>& factors, const std::unordered_set<const double*>& fixed);
-  // Assembles the undamped Gauss-Newton Hessian of the last linearization.
-  void assembleHessian();
-  // Factors the Hessian damped by mu: the groups' band Cholesky and Schur complements, then
-  // the separator's dense Cholesky. False when one fails.
+  double totalCost(const std::vector<const Factor*>& factors);
+  // Factors the Hessian damped by mu (Levenberg-Marquardt, as Ceres: H + mu diag(H)): the
+  // groups' band Cholesky and Schur complements, then the separator's dense Cholesky. False
+  // when one fails.
   bool factor(double mu);
   // The step for the current gradient from the last factorization, into step_sep_ and
   // step_groups_.
   void substitute();
-  double modelCostChange() const;
+  double modelCostChange();
   Vector6 stepOf(const Slot& s) const;
 
+  ParallelFor* parallel_ = nullptr;
   std::vector<double*> separator_;
   std::vector<Group> groups_;
+  std::vector<int> separator_factors_;  // factors touching no group
+  std::vector<double> item_sums_;       // per item, summed in item order (deterministic)
   std::unordered_map<const double*, Slot> where_;
   std::vector<std::vector<Slot>> slots_;  // per factor, per block
   int n_sep_ = 0, tail_dim_ = 0;
   std::vector<FactorLinearization> lin_;
-  Eigen::MatrixXd H_sep_;  // undamped, before the groups' Schur complements
-  Eigen::VectorXd g_sep_;
+  Eigen::MatrixXd H_sep_;  // undamped, of the separator's own factors only
+  Eigen::VectorXd g_sep_;  // of all factors
+  Eigen::VectorXd diag_sep_;  // of the whole separator Hessian (H_sep_ and the groups' D), for damping
   // Damped, after them; factor() leaves the separator's Cholesky factor in its lower triangle.
   Eigen::MatrixXd H_reduced_;
   Eigen::VectorXd step_sep_;

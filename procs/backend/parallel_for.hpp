@@ -1,0 +1,52 @@
+// A fixed set of worker threads for the backend's loops over independent items (the objects'
+// eliminations, the factors' linearizations): the calling thread works too, so `threads` = 2
+// uses one worker. Items are handed out one at a time (objects differ in size); results go to
+// per-item slots that the caller then sums in item order, so the outcome does not depend on
+// the number of threads or on which thread ran what.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace dlslot::backend {
+
+class ParallelFor {
+ public:
+  explicit ParallelFor(int threads = 1);
+  ~ParallelFor();
+  ParallelFor(const ParallelFor&) = delete;
+  ParallelFor& operator=(const ParallelFor&) = delete;
+
+  int threads() const { return static_cast<int>(workers_.size()) + 1; }
+
+  // Calls task(i) for every i in [0, n) and returns when all calls have returned. The first
+  // exception a task throws is rethrown here (the other items still run).
+  void operator()(int n, const std::function<void(int)>& task);
+
+ private:
+  struct Job {
+    const std::function<void(int)>* task = nullptr;
+    int n = 0;
+    std::atomic<int> next{0}, done{0};
+    std::mutex error_mutex;
+    std::exception_ptr error;
+    void work();  // claims and runs items until none is left
+  };
+  void workerLoop();
+
+  std::vector<std::thread> workers_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::shared_ptr<Job> job_;            // the current job; a late worker keeps it alive
+  std::atomic<unsigned> generation_{0};  // bumped per job: workers spin on it before sleeping
+  int sleeping_ = 0;
+  bool stop_ = false;
+};
+
+}  // namespace dlslot::backend

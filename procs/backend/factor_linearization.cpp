@@ -15,6 +15,7 @@ void applyLoss(const ceres::LossFunction& loss, FactorLinearization& lin) {
   const double s = lin.r.squaredNorm();
   double rho[3];
   loss.Evaluate(s, rho);
+  lin.cost = 0.5 * rho[0];
   const double sqrt_rho1 = std::sqrt(std::max(rho[1], 0.0));
   if (s == 0.0 || rho[2] <= 0.0) {
     lin.r *= sqrt_rho1;
@@ -35,7 +36,7 @@ void linearize(const Factor& f, const std::unordered_set<const double*>& fixed, 
   for (int k = 0; k < nb; ++k) lin.estimated[k] = !fixed.count(f.blocks[k]);
   lin.prior = dynamic_cast<const MarginalizationPrior*>(f.cost.get());
   if (lin.prior) {
-    lin.prior->gradient(f.blocks.data(), lin.M, lin.g);
+    lin.cost = lin.prior->gradient(f.blocks.data(), lin.M, lin.g);
     for (int k = 0; k < nb; ++k)
       if (!lin.estimated[k]) lin.g.segment<6>(6 * k).setZero();
     return;
@@ -52,6 +53,7 @@ void linearize(const Factor& f, const std::unordered_set<const double*>& fixed, 
     }
   }
   lin.r = factor->evaluate(f.blocks.data(), J);
+  lin.cost = 0.5 * lin.r.squaredNorm();
   if (f.loss) applyLoss(*f.loss, lin);
 }
 

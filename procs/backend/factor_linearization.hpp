@@ -19,6 +19,7 @@ class MarginalizationPrior;
 struct FactorLinearization {
   // Every factor but the prior has a 6-dimensional residual (an SE(3) error), so fixed sizes.
   Vector6 r = Vector6::Zero();   // residual (robust loss applied)
+  double cost = 0;               // the factor's cost at the linearization point (factorCost)
   std::vector<Matrix6> J;        // per block: tangent Jacobian
   std::vector<bool> estimated;   // per block: false when fixed (its terms are zero)
   const MarginalizationPrior* prior = nullptr;  // a prior: g and M below instead of r and J

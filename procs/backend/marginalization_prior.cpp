@@ -11,6 +11,7 @@ MarginalizationPrior::MarginalizationPrior(std::vector<Vector7> x_lin, Eigen::Ma
   for (size_t i = 0; i < x_lin_.size(); ++i) mutable_parameter_block_sizes()->push_back(kPoseSize);
   if (JtJ_.size() == 0) JtJ_.noalias() = J_.transpose() * J_;
   if (Jtr0_.size() == 0) Jtr0_.noalias() = J_.transpose() * r0_;
+  half_r0_squared_ = 0.5 * r0_.squaredNorm();
 }
 
 MarginalizationPrior* MarginalizationPrior::CreatePosePrior(const Pose& x0, const Matrix6& sqrt_info) {
@@ -33,7 +34,7 @@ bool MarginalizationPrior::Evaluate(double const* const* x, double* residuals, d
   return true;
 }
 
-void MarginalizationPrior::gradient(double const* const* x, std::vector<Matrix6>& M, Eigen::VectorXd& g) const {
+double MarginalizationPrior::gradient(double const* const* x, std::vector<Matrix6>& M, Eigen::VectorXd& g) const {
   const int n = numBlocks();
   Eigen::VectorXd dx(kTangentSize * n);
   M.resize(n);
@@ -46,6 +47,7 @@ void MarginalizationPrior::gradient(double const* const* x, std::vector<Matrix6>
   g0.noalias() += JtJ_ * dx;
   g.resize(6 * n);
   for (int i = 0; i < n; ++i) g.segment<6>(6 * i).noalias() = M[i].transpose() * g0.segment<6>(6 * i);
+  return half_r0_squared_ + 0.5 * dx.dot(Jtr0_ + g0);
 }
 
 void MarginalizationPrior::hessian(const std::vector<Matrix6>& M, Eigen::MatrixXd& H) const {

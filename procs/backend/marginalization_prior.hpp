@@ -28,8 +28,9 @@ class MarginalizationPrior final : public ceres::CostFunction {
   // The Gauss-Newton terms at x in the blocks' tangent spaces, without forming Jx^T Jx from the
   // dense rows: Jx = J blockdiag(M) with M_i = d(x_i [-] x_lin_i)/dx_i, so the gradient is
   // g = M^T (J^T r0 + J^T J dx) and the Hessian blockdiag(M)^T (J^T J) blockdiag(M), formed
-  // only when a solver needs it. J^T J and J^T r0 are kept from construction.
-  void gradient(double const* const* x, std::vector<Matrix6>& M, Eigen::VectorXd& g) const;
+  // only when a solver needs it. J^T J and J^T r0 are kept from construction. Returns the
+  // cost 0.5 |r(x)|^2 = 0.5 |r0|^2 + 0.5 dx . (J^T r0 + J^T J dx + J^T r0), dx = x [-] x_lin.
+  double gradient(double const* const* x, std::vector<Matrix6>& M, Eigen::VectorXd& g) const;
   void hessian(const std::vector<Matrix6>& M, Eigen::MatrixXd& H) const;
   // The whole H = Jx^T Jx and g = Jx^T r(x) (for tests and small priors).
   void linearize(double const* const* x, Eigen::MatrixXd& H, Eigen::VectorXd& g) const;
@@ -46,6 +47,7 @@ class MarginalizationPrior final : public ceres::CostFunction {
   Eigen::VectorXd r0_;
   Eigen::MatrixXd JtJ_;
   Eigen::VectorXd Jtr0_;
+  double half_r0_squared_ = 0;
 };
 
 }  // namespace dlslot::backend

@@ -156,9 +156,11 @@ void WindowSolver::forEachItem(const std::function<void(int)>& work) {
   }
 }
 
-void WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
-                                const std::unordered_set<const double*>& fixed) {
+double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
+                                  const std::unordered_set<const double*>& fixed) {
+  ++linearizations_;
   lin_.resize(factors.size());
+  item_sums_.assign(groups_.size() + 1, 0.0);
   forEachItem([&](int item) {
     Eigen::MatrixXd Hf;
     if (item == 0) {
@@ -176,6 +178,7 @@ void WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
     for (int i : itemFactors(item)) {
       FactorLinearization& lin = lin_[i];
       linearize(*factors[i], fixed, lin);
+      item_sums_[item] += lin.cost;
       lin.hessian(Hf);
       const std::vector<Slot>& slots = slots_[i];
       const int nb = static_cast<int>(slots.size());
@@ -217,6 +220,9 @@ void WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
     }
   max_gradient_ = n_sep_ > 0 ? g_sep_.cwiseAbs().maxCoeff() : 0.0;
   for (const Group& g : groups_) max_gradient_ = std::max(max_gradient_, g.g.cwiseAbs().maxCoeff());
+  double cost = 0;
+  for (double c : item_sums_) cost += c;
+  return cost;
 }
 
 double WindowSolver::totalCost(const std::vector<const Factor*>& factors) {
@@ -232,6 +238,7 @@ double WindowSolver::totalCost(const std::vector<const Factor*>& factors) {
 bool WindowSolver::factor(double mu) {
   // Each group's Schur complement: with H_k = L L^T and Y = L^-1 C, the separator keeps
   // D - Y^T Y over the blocks the group touches.
+  factored_linearization_ = -1;  // until it succeeds
   std::vector<char> ok(groups_.size());
   forEachItem([&](int item) {
     if (item == 0) return;
@@ -244,6 +251,7 @@ bool WindowSolver::factor(double mu) {
     dense::subtractGramRows(grp.Y, grp.S);
   });
   if (std::find(ok.begin(), ok.end(), 0) != ok.end()) return false;
+  factored_linearization_ = linearizations_;
   // Lower triangles only: touched is in separator order, so S's lower blocks land in
   // H_reduced_'s lower triangle, the only one the Cholesky reads.
   H_reduced_ = H_sep_;
@@ -315,9 +323,10 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
   setUp(separator, groups, fixed, tail);
   mapFactors(factors);
   Summary summary;
-  double cost = summary.initial_cost = totalCost(factors);
-  summary.final_cost = cost;
-  if (where_.empty()) return summary;
+  if (where_.empty()) {
+    summary.initial_cost = summary.final_cost = totalCost(factors);
+    return summary;
+  }
 
   // Every estimated block with its step's slot, for applying and undoing steps.
   std::vector<std::pair<double*, Slot>> estimated;
@@ -328,7 +337,7 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
   PoseManifold manifold;
   double radius = options.initial_trust_region_radius, decrease_factor = 2.0;
   double factored_mu = -1;  // damping of the last factorization, -1: none yet
-  linearizeAll(factors, fixed);
+  double cost = summary.initial_cost = summary.final_cost = linearizeAll(factors, fixed);
   for (int it = 0; it < options.max_iterations; ++it) {
     if (max_gradient_ <= options.gradient_tolerance) break;
     ++summary.iterations;
@@ -351,20 +360,23 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
       const Vector6 d = stepOf(estimated[i].second);
       manifold.Plus(saved[i].data(), d.data(), estimated[i].first);
     }
-    const double new_cost = totalCost(factors);
+    // The new point's cost: from linearizing there when another step may follow (which an
+    // accepted step needs anyway), else from the residuals alone.
+    const bool last = it + 1 == options.max_iterations;
+    const double new_cost = last ? totalCost(factors) : linearizeAll(factors, fixed);
     const double rho = (cost - new_cost) / model_change;
     if (model_change > 0 && rho > 1e-3) {
       radius = radius / std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
       decrease_factor = 2.0;
       const bool converged = cost - new_cost <= options.function_tolerance * cost;
       cost = new_cost;
-      if (converged || it + 1 == options.max_iterations) break;
-      linearizeAll(factors, fixed);
+      if (converged || last) break;
     } else {
       for (size_t i = 0; i < estimated.size(); ++i)
         std::copy(saved[i].data(), saved[i].data() + 7, estimated[i].first);
       radius /= decrease_factor;
       decrease_factor *= 2;
+      if (!last) linearizeAll(factors, fixed);  // back at the kept point
     }
   }
   summary.final_cost = cost;
@@ -372,8 +384,9 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
   // Covariances want the undamped system: even mu = 1e-4 times the diagonal changes them by
   // percents along the window's weakly determined directions (a chain's diagonal is much larger
   // than its marginal information). Factor again (at the solution) when the last factorization
-  // was damped more than rounding (the tiny mu only guards against it).
-  if (factored_mu < 0 || factored_mu > 1e-7) {
+  // was damped more than rounding (the tiny mu only guards against it), or the groups' matrices
+  // were linearized again since.
+  if (factored_mu < 0 || factored_mu > 1e-7 || factored_linearization_ != linearizations_) {
     linearizeAll(factors, fixed);
     if (!factor(1e-12)) return summary;
   }

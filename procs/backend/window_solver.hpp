@@ -109,8 +109,9 @@ class WindowSolver {
   const std::vector<int>& itemFactors(int item) const {
     return item == 0 ? separator_factors_ : groups_[item - 1].factors;
   }
-  // Linearizes every factor, assembles the gradient and the undamped Gauss-Newton Hessian.
-  void linearizeAll(const std::vector<const Factor*>& factors, const std::unordered_set<const double*>& fixed);
+  // Linearizes every factor, assembles the gradient and the undamped Gauss-Newton Hessian;
+  // returns the cost there.
+  double linearizeAll(const std::vector<const Factor*>& factors, const std::unordered_set<const double*>& fixed);
   double totalCost(const std::vector<const Factor*>& factors);
   // Factors the Hessian damped by mu (Levenberg-Marquardt, as Ceres: H + mu diag(H)): the
   // groups' band Cholesky and Schur complements, then the separator's dense Cholesky. False
@@ -139,6 +140,7 @@ class WindowSolver {
   Eigen::VectorXd step_sep_;
   std::vector<Eigen::VectorXd> step_groups_;
   double max_gradient_ = 0;
+  int linearizations_ = 0, factored_linearization_ = -1;  // which linearization factor() used
   Eigen::MatrixXd tail_cov_;  // joint covariance of the tail blocks
 };
 

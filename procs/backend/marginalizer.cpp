@@ -39,12 +39,7 @@ void schurComplement(Eigen::MatrixXd& H_mm, Eigen::MatrixXd& H_mr, Eigen::Matrix
       const int p = first_row[c0];
       dense::solveLower(L.bottomRightCorner(nm - p, nm - p), Y.block(p, 6 * c0, nm - p, 6 * (c1 - c0)));
     };
-    const int groups = static_cast<int>(column_groups.size());
-    if (parallel) {
-      (*parallel)(groups, solve);
-    } else {
-      for (int k = 0; k < groups; ++k) solve(k);
-    }
+    parallelFor(parallel, static_cast<int>(column_groups.size()), solve);
     dense::solveLower(L, g_m);
   } else {
     // The Cholesky left the upper triangle alone: H_mm is still there, but for its diagonal.
@@ -145,11 +140,7 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
     lin[i].hessian(Hf[i]);
   };
   const int nf = static_cast<int>(factors.size());
-  if (parallel_) {
-    (*parallel_)(nf, linearizeFactor);
-  } else {
-    for (int i = 0; i < nf; ++i) linearizeFactor(i);
-  }
+  parallelFor(parallel_, nf, linearizeFactor);
   Eigen::MatrixXd H_mm = Eigen::MatrixXd::Zero(nm, nm), H_mr = Eigen::MatrixXd::Zero(nm, nr);
   Eigen::MatrixXd H_star = Eigen::MatrixXd::Zero(nr, nr);
   Eigen::VectorXd g_m = Eigen::VectorXd::Zero(nm), g_star = Eigen::VectorXd::Zero(nr);

@@ -49,4 +49,13 @@ class ParallelFor {
   bool stop_ = false;
 };
 
+// task(i) for i in [0, n) on `pool`'s threads, or in order on this thread without a pool.
+inline void parallelFor(ParallelFor* pool, int n, const std::function<void(int)>& task) {
+  if (pool) {
+    (*pool)(n, task);
+  } else {
+    for (int i = 0; i < n; ++i) task(i);
+  }
+}
+
 }  // namespace dlslot::backend

@@ -148,21 +148,24 @@ void WindowSolver::mapFactors(const std::vector<const Factor*>& factors) {
 }
 
 void WindowSolver::forEachItem(const std::function<void(int)>& work) {
-  const int items = static_cast<int>(groups_.size()) + 1;
-  if (parallel_) {
-    (*parallel_)(items, work);
-  } else {
-    for (int i = 0; i < items; ++i) work(i);
-  }
+  parallelFor(parallel_, static_cast<int>(groups_.size()) + 1, work);
+}
+
+double WindowSolver::sumOverItems(const std::function<double(int)>& work) {
+  item_sums_.assign(groups_.size() + 1, 0.0);
+  forEachItem([&](int item) { item_sums_[item] = work(item); });
+  double sum = 0;
+  for (double s : item_sums_) sum += s;
+  return sum;
 }
 
 double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
                                   const std::unordered_set<const double*>& fixed) {
   ++linearizations_;
   lin_.resize(factors.size());
-  item_sums_.assign(groups_.size() + 1, 0.0);
-  forEachItem([&](int item) {
+  const double cost = sumOverItems([&](int item) {
     Eigen::MatrixXd Hf;
+    double item_cost = 0;
     if (item == 0) {
       g_sep_.setZero(n_sep_);
       H_sep_.setZero(n_sep_, n_sep_);
@@ -178,7 +181,7 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
     for (int i : itemFactors(item)) {
       FactorLinearization& lin = lin_[i];
       linearize(*factors[i], fixed, lin);
-      item_sums_[item] += lin.cost;
+      item_cost += lin.cost;
       lin.hessian(Hf);
       const std::vector<Slot>& slots = slots_[i];
       const int nb = static_cast<int>(slots.size());
@@ -211,6 +214,7 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
         }
       }
     }
+    return item_cost;
   });
   diag_sep_ = H_sep_.diagonal();
   for (const Group& g : groups_)
@@ -220,19 +224,15 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
     }
   max_gradient_ = n_sep_ > 0 ? g_sep_.cwiseAbs().maxCoeff() : 0.0;
   for (const Group& g : groups_) max_gradient_ = std::max(max_gradient_, g.g.cwiseAbs().maxCoeff());
-  double cost = 0;
-  for (double c : item_sums_) cost += c;
   return cost;
 }
 
 double WindowSolver::totalCost(const std::vector<const Factor*>& factors) {
-  item_sums_.assign(groups_.size() + 1, 0.0);
-  forEachItem([&](int item) {
-    for (int i : itemFactors(item)) item_sums_[item] += factorCost(*factors[i]);
+  return sumOverItems([&](int item) {
+    double cost = 0;
+    for (int i : itemFactors(item)) cost += factorCost(*factors[i]);
+    return cost;
   });
-  double cost = 0;
-  for (double c : item_sums_) cost += c;
-  return cost;
 }
 
 bool WindowSolver::factor(double mu) {
@@ -300,18 +300,16 @@ Vector6 WindowSolver::stepOf(const Slot& s) const {
 
 double WindowSolver::modelCostChange() {
   // cost - 0.5 |r + J dx|^2 summed over the factors (the linear model's predicted decrease).
-  item_sums_.assign(groups_.size() + 1, 0.0);
-  forEachItem([&](int item) {
+  return sumOverItems([&](int item) {
+    double change = 0;
     std::vector<Vector6> dx;
     for (int i : itemFactors(item)) {
       dx.clear();
       for (const Slot& s : slots_[i]) dx.push_back(stepOf(s));
-      item_sums_[item] += lin_[i].modelDecrease(dx);
+      change += lin_[i].modelDecrease(dx);
     }
+    return change;
   });
-  double change = 0;
-  for (double c : item_sums_) change += c;
-  return change;
 }
 
 WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& factors,

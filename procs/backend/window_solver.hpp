@@ -106,6 +106,8 @@ class WindowSolver {
   void mapFactors(const std::vector<const Factor*>& factors);
   // Calls work(i) for each item: 0 the separator's own factors, k + 1 group k.
   void forEachItem(const std::function<void(int)>& work);
+  // The sum of work(item) over the items, in item order (the same for any thread count).
+  double sumOverItems(const std::function<double(int)>& work);
   const std::vector<int>& itemFactors(int item) const {
     return item == 0 ? separator_factors_ : groups_[item - 1].factors;
   }

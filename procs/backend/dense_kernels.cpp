@@ -2,6 +2,7 @@
 #include "backend/dense_kernels.hpp"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 
 namespace dlslot::backend::dense::raw {
 namespace {
@@ -9,6 +10,27 @@ namespace {
 using Stride = Eigen::OuterStride<>;
 using Map = Eigen::Map<Eigen::MatrixXd, 0, Stride>;
 using ConstMap = Eigen::Map<const Eigen::MatrixXd, 0, Stride>;
+using Block6 = Eigen::Map<Eigen::Matrix<double, 6, 6>>;
+using ConstBlock6 = Eigen::Map<const Eigen::Matrix<double, 6, 6>>;
+using Rows6 = Eigen::Map<Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>, 0, Stride>;
+using ConstRows6 = Eigen::Map<const Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>, 0, Stride>;
+
+// B <- B - A X for a 6x6 A and 6 x n row-major B, X: row by row, each row a sum of scaled
+// rows of X, which vectorizes along n (Eigen's general product costs more at these sizes).
+void subtractProduct(const Eigen::Matrix<double, 6, 6>& A, const ConstRows6& X, Rows6& B) {
+  for (int r = 0; r < 6; ++r)
+    B.row(r) -= A(r, 0) * X.row(0) + A(r, 1) * X.row(1) + A(r, 2) * X.row(2) + A(r, 3) * X.row(3) +
+                A(r, 4) * X.row(4) + A(r, 5) * X.row(5);
+}
+
+// B <- A B for a 6x6 A (through a copy of B).
+void multiplyInPlace(const Eigen::Matrix<double, 6, 6>& A, Rows6& B, Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>& tmp) {
+  tmp = B;
+  const ConstRows6 X(tmp.data(), 6, tmp.cols(), Stride(tmp.cols()));
+  for (int r = 0; r < 6; ++r)
+    B.row(r) = A(r, 0) * X.row(0) + A(r, 1) * X.row(1) + A(r, 2) * X.row(2) + A(r, 3) * X.row(3) +
+               A(r, 4) * X.row(4) + A(r, 5) * X.row(5);
+}
 
 }  // namespace
 
@@ -36,6 +58,50 @@ void subtractGram(const double* Y, int k, int n, int ldy, double* S, int lds) {
 
 void subtractOuter(const double* X, int n, int k, int ldx, double* S, int lds) {
   Map(S, n, n, Stride(lds)).selfadjointView<Eigen::Lower>().rankUpdate(ConstMap(X, n, k, Stride(ldx)), -1.0);
+}
+
+// Row by row of blocks: L(i,j) = (H(i,j) - sum_k L(i,k) L(j,k)^T) L(j,j)^-T for j < i, and
+// L(i,i) the Cholesky factor of what remains on the diagonal; only blocks within the band.
+bool bandCholesky(const double* H, int m, int w, const double* damping, double* L, double* L_inv) {
+  auto at = [&](int i, int d) { return Block6(L + 36 * (i * (w + 1) + d)); };
+  for (int i = 0; i < m; ++i) {
+    for (int d = std::min(i, w); d >= 0; --d) {
+      const int j = i - d;
+      Eigen::Matrix<double, 6, 6> S = ConstBlock6(H + 36 * (i * (w + 1) + d));
+      for (int k = std::max(0, i - w); k < j; ++k) S.noalias() -= at(i, i - k) * at(j, j - k).transpose();
+      if (d > 0) {
+        at(i, d).noalias() = S * ConstBlock6(L_inv + 36 * j).transpose();
+        continue;
+      }
+      for (int r = 0; r < 6; ++r) S(r, r) += damping[6 * i + r];
+      Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(S);
+      if (llt.info() != Eigen::Success) return false;
+      at(i, 0) = llt.matrixL();
+      Block6(L_inv + 36 * i) = llt.matrixL().solve(Eigen::Matrix<double, 6, 6>::Identity());
+    }
+  }
+  return true;
+}
+
+void bandSolveLower(const double* L, const double* L_inv, int m, int w, double* B, int cols, const int* widths) {
+  Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor> tmp;
+  for (int i = 0; i < m; ++i) {
+    const int n = widths ? widths[i] : cols;
+    Rows6 Bi(B + 6 * i * cols, 6, n, Stride(cols));
+    for (int k = std::max(0, i - w); k < i; ++k)
+      subtractProduct(ConstBlock6(L + 36 * (i * (w + 1) + i - k)), ConstRows6(B + 6 * k * cols, 6, n, Stride(cols)), Bi);
+    multiplyInPlace(ConstBlock6(L_inv + 36 * i), Bi, tmp);
+  }
+}
+
+void bandSolveLowerTransposed(const double* L, const double* L_inv, int m, int w, double* B, int cols) {
+  Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor> tmp;
+  for (int i = m - 1; i >= 0; --i) {
+    Rows6 Bi(B + 6 * i * cols, 6, cols, Stride(cols));
+    for (int k = i + 1; k <= std::min(m - 1, i + w); ++k)
+      subtractProduct(ConstBlock6(L + 36 * (k * (w + 1) + k - i)).transpose(), ConstRows6(B + 6 * k * cols, 6, cols, Stride(cols)), Bi);
+    multiplyInPlace(ConstBlock6(L_inv + 36 * i).transpose(), Bi, tmp);
+  }
 }
 
 }  // namespace dlslot::backend::dense::raw

@@ -16,49 +16,20 @@ double damping(double diagonal, double mu) { return mu * std::clamp(diagonal, 1e
 
 }  // namespace
 
-// Row by row of blocks: L(i,j) = (H(i,j) - sum_k L(i,k) L(j,k)^T) L(j,j)^-T for j < i, and
-// L(i,i) the Cholesky factor of what remains on the diagonal; only blocks within the band.
 bool WindowSolver::BandCholesky::compute(const std::vector<Matrix6>& H, int blocks, int bandwidth, double mu) {
   m = blocks;
   w = bandwidth;
-  L.resize(H.size());
-  L_inv.resize(m);
-  for (int i = 0; i < m; ++i) {
-    for (int d = std::min(i, w); d >= 0; --d) {
-      const int j = i - d;
-      Matrix6 S = H[i * (w + 1) + d];
-      for (int k = std::max(0, i - w); k < j; ++k) S.noalias() -= at(i, i - k) * at(j, j - k).transpose();
-      if (d > 0) {
-        at(i, d).noalias() = S * L_inv[j].transpose();
-        continue;
-      }
-      for (int r = 0; r < 6; ++r) S(r, r) += damping(S(r, r), mu);
-      Eigen::LLT<Matrix6> llt(S);
-      if (llt.info() != Eigen::Success) return false;
-      at(i, 0) = llt.matrixL();
-      L_inv[i] = llt.matrixL().solve(Matrix6::Identity());
-    }
-  }
-  return true;
+  Eigen::VectorXd added(6 * m);
+  for (int i = 0; i < m; ++i)
+    for (int r = 0; r < 6; ++r) added(6 * i + r) = damping(H[i * (w + 1)](r, r), mu);
+  return dense::bandCholesky(H, m, w, added, L, L_inv);
 }
 
 void WindowSolver::BandCholesky::solveL(RowMatrix& B, const std::vector<int>* widths) const {
-  for (int i = 0; i < m; ++i) {
-    const int n = widths ? (*widths)[i] : static_cast<int>(B.cols());
-    auto Bi = B.block(6 * i, 0, 6, n);
-    for (int k = std::max(0, i - w); k < i; ++k) Bi.noalias() -= at(i, i - k) * B.block(6 * k, 0, 6, n);
-    Bi = (L_inv[i] * Bi).eval();
-  }
+  dense::bandSolveLower(L, L_inv, w, B, widths);
 }
 
-void WindowSolver::BandCholesky::solveLt(RowMatrix& B) const {
-  for (int i = m - 1; i >= 0; --i) {
-    auto Bi = B.middleRows<6>(6 * i);
-    for (int k = i + 1; k <= std::min(m - 1, i + w); ++k)
-      Bi.noalias() -= at(k, k - i).transpose() * B.middleRows<6>(6 * k);
-    Bi = (L_inv[i].transpose() * Bi).eval();
-  }
-}
+void WindowSolver::BandCholesky::solveLt(RowMatrix& B) const { dense::bandSolveLowerTransposed(L, L_inv, w, B); }
 
 void WindowSolver::setUp(const std::vector<double*>& separator, const std::vector<std::vector<double*>>& groups,
                          const std::unordered_set<const double*>& fixed, int tail) {

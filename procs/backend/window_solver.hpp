@@ -63,8 +63,6 @@ class WindowSolver {
     int m = 0, w = 0;
     std::vector<Matrix6> L;  // L(i, i - d) at [i * (w + 1) + d]
     std::vector<Matrix6> L_inv;  // L(i, i)^-1: substitution by products (6x6 solves are slow)
-    Matrix6& at(int i, int d) { return L[i * (w + 1) + d]; }
-    const Matrix6& at(int i, int d) const { return L[i * (w + 1) + d]; }
     // Factors the band `H` (same layout) damped by mu diag(H); false when not definite.
     bool compute(const std::vector<Matrix6>& H, int m, int w, double mu);
     // B <- L^-1 B (B: 6m rows). With `widths`, row block i of B is zero beyond widths[i]

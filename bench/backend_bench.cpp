@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "../tests/backend_scene.hpp"
+#include "backend/heap_memory.hpp"
 #include "backend/sliding_window.hpp"
 #include "dlslot/timing_stats.hpp"
 
@@ -48,6 +49,7 @@ SimScene scene(int moving, int parked) {
 }
 
 void optimizeFrame(benchmark::State& state) {
+  retainFreedMemory();  // as dlslot-backend does
   const int moving = static_cast<int>(state.range(0)), parked = static_cast<int>(state.range(1));
   const bool covariance = state.range(2) != 0;
   const int iterations_per_frame = static_cast<int>(state.range(3));

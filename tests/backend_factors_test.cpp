@@ -6,6 +6,8 @@
 
 #include <memory>
 #include <random>
+#include <unordered_set>
+#include <Eigen/Eigenvalues>
 
 #include "backend/backend_config.hpp"
 #include "backend/constant_velocity_factor.hpp"
@@ -333,56 +335,115 @@ TEST(BackendMarginalizer, SchurComplementOfTheLinearizedSystem) {
   EXPECT_TRUE(gr.isApprox(expected_g, 1e-8));
 }
 
+// The Schur complement of the full linearization (H, g over `full`'s blocks) onto the blocks
+// `reduced` keeps, in `reduced`'s block order; H_mm^-1 is the pseudo-inverse (eigenvalues below
+// 1e-8 of the largest dropped), which is the inverse when H_mm is definite.
+std::pair<Eigen::MatrixXd, Eigen::VectorXd> expectedSchur(const Factor& full, const Factor& reduced,
+                                                          const std::unordered_set<const double*>& leaving) {
+  Eigen::MatrixXd H;
+  Eigen::VectorXd g;
+  dynamic_cast<const MarginalizationPrior&>(*full.cost).linearize(full.blocks.data(), H, g);
+  std::vector<int> m, r;
+  for (int k = 0; k < static_cast<int>(full.blocks.size()); ++k)
+    for (int d = 0; d < 6; ++d) (leaving.count(full.blocks[k]) ? m : r).push_back(6 * k + d);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H(m, m));
+  const Eigen::VectorXd lambda = es.eigenvalues();
+  const Eigen::VectorXd inv = (lambda.array() > 1e-8 * lambda.maxCoeff()).select(lambda.cwiseInverse(), 0.0);
+  const Eigen::MatrixXd Hmm_inv = es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
+  const Eigen::MatrixXd Hmr = H(m, r);
+  const Eigen::MatrixXd expected_H = H(r, r) - Hmr.transpose() * Hmm_inv * Hmr;
+  const Eigen::VectorXd expected_g = g(r) - Hmr.transpose() * Hmm_inv * g(m);
+  std::vector<int> perm;  // reduced block k -> its rows in expected_*
+  for (double* b : reduced.blocks) {
+    int pos = 0;
+    for (double* a : full.blocks)
+      if (!leaving.count(a)) {
+        if (a == b) break;
+        ++pos;
+      }
+    for (int d = 0; d < 6; ++d) perm.push_back(6 * pos + d);
+  }
+  return {expected_H(perm, perm), expected_g(perm)};
+}
+
 // Several leaving blocks, each kept block coupled to a different one (a staircase in L^-1 H_mr,
-// which the Marginalizer exploits), under a dense prior: still exactly the Schur complement.
+// which the Marginalizer exploits panel by panel: 6 kept blocks make two panels), under a
+// dense prior: still exactly the Schur complement.
 TEST(BackendMarginalizer, StaircaseSchurComplementUnderADensePrior) {
   std::mt19937 rng(12);
+  const int n = 6;
   std::vector<Vector7> blocks;
-  for (int i = 0; i < 8; ++i) blocks.push_back(toBlock(randomPose(rng)));
+  for (int i = 0; i < 2 * n; ++i) blocks.push_back(toBlock(randomPose(rng)));
   std::vector<Factor> factors;
   auto add = [&](ceres::CostFunction* c, std::vector<int> b) {
     std::vector<double*> ptrs;
     for (int i : b) ptrs.push_back(blocks[i].data());
     factors.push_back({std::shared_ptr<ceres::CostFunction>(c), nullptr, ptrs});
   };
-  // A dense prior over blocks 0-3 (they leave), then chains 0->4, 1->5, 2->6, 3->7.
-  std::vector<Vector7> x_lin(blocks.begin(), blocks.begin() + 4);
-  const Eigen::MatrixXd J = Eigen::MatrixXd::Random(24, 24) + 5.0 * Eigen::MatrixXd::Identity(24, 24);
-  factors.push_back({std::make_shared<MarginalizationPrior>(x_lin, J, Eigen::VectorXd::Random(24)), nullptr,
-                     {blocks[0].data(), blocks[1].data(), blocks[2].data(), blocks[3].data()}});
-  for (int i = 0; i < 4; ++i) add(OdometryFactor::Create(error(rng), randomSqrtInfo(rng)), {i, i + 4});
-  add(PoseChangeFactor::Create(randomSqrtInfo(rng)), {2, 6, 5});
+  // A dense prior over blocks 0..n-1 (they leave), then chains i -> i + n.
+  std::vector<Vector7> x_lin(blocks.begin(), blocks.begin() + n);
+  const Eigen::MatrixXd J = Eigen::MatrixXd::Random(6 * n, 6 * n) + 5.0 * Eigen::MatrixXd::Identity(6 * n, 6 * n);
+  std::vector<double*> prior_blocks;
+  std::unordered_set<const double*> leaving;
+  for (int i = 0; i < n; ++i) {
+    prior_blocks.push_back(blocks[i].data());
+    leaving.insert(blocks[i].data());
+  }
+  factors.push_back({std::make_shared<MarginalizationPrior>(x_lin, J, Eigen::VectorXd::Random(6 * n)), nullptr,
+                     prior_blocks});
+  for (int i = 0; i < n; ++i) add(OdometryFactor::Create(error(rng), randomSqrtInfo(rng)), {i, i + n});
+  add(PoseChangeFactor::Create(randomSqrtInfo(rng)), {2, n + 2, n + 1});
   std::vector<const Factor*> all;
   for (const Factor& f : factors) all.push_back(&f);
   Marginalizer marginalizer;
   const auto full = marginalizer.marginalize(all, {}, {});
-  const auto reduced =
-      marginalizer.marginalize(all, {blocks[0].data(), blocks[1].data(), blocks[2].data(), blocks[3].data()}, {});
+  const auto reduced = marginalizer.marginalize(all, leaving, {});
   ASSERT_TRUE(full && reduced);
-  EXPECT_EQ(marginalizer.lastStats().leaving_dim, 24);
-  Eigen::MatrixXd H, Hr;
-  Eigen::VectorXd g, gr;
-  dynamic_cast<const MarginalizationPrior&>(*full->cost).linearize(full->blocks.data(), H, g);
+  EXPECT_EQ(marginalizer.lastStats().leaving_dim, 6 * n);
+  EXPECT_EQ(marginalizer.lastStats().kept_dim, 6 * n);
+  Eigen::MatrixXd Hr;
+  Eigen::VectorXd gr;
   dynamic_cast<const MarginalizationPrior&>(*reduced->cost).linearize(reduced->blocks.data(), Hr, gr);
-  // Expected, in full's block order, then permuted to reduced's.
-  std::vector<int> m, r;
-  for (int k = 0; k < static_cast<int>(full->blocks.size()); ++k)
-    for (int d = 0; d < 6; ++d) (full->blocks[k] < blocks[4].data() ? m : r).push_back(6 * k + d);
-  const Eigen::MatrixXd Hmm = H(m, m), Hmr = H(m, r);
-  const Eigen::MatrixXd expected_H = H(r, r) - Hmr.transpose() * Hmm.inverse() * Hmr;
-  const Eigen::VectorXd expected_g = g(r) - Hmr.transpose() * Hmm.inverse() * g(m);
-  std::vector<int> perm;  // reduced block k -> its rows in expected_*
-  for (double* b : reduced->blocks) {
-    int pos = 0;
-    for (int k = 0; k < static_cast<int>(full->blocks.size()); ++k)
-      if (!(full->blocks[k] < blocks[4].data())) {
-        if (full->blocks[k] == b) break;
-        ++pos;
-      }
-    for (int d = 0; d < 6; ++d) perm.push_back(6 * pos + d);
-  }
-  EXPECT_TRUE(Hr.isApprox(expected_H(perm, perm), 1e-8));
-  EXPECT_TRUE(gr.isApprox(expected_g(perm), 1e-8));
+  const auto [expected_H, expected_g] = expectedSchur(*full, *reduced, leaving);
+  EXPECT_TRUE(Hr.isApprox(expected_H, 1e-8));
+  EXPECT_TRUE(gr.isApprox(expected_g, 1e-8));
+}
+
+// A leaving block with a direction no factor constrains (its only factor's information has a
+// zero row): H_mm is singular and the Marginalizer falls back to the pseudo-inverse, which
+// passes on what the other directions say and nothing about the free one.
+TEST(BackendMarginalizer, SingularLeavingBlockUsesThePseudoInverse) {
+  std::mt19937 rng(13);
+  std::vector<Vector7> blocks;
+  for (int i = 0; i < 3; ++i) blocks.push_back(toBlock(randomPose(rng)));
+  Matrix6 S = randomSqrtInfo(rng);
+  S.row(4).setZero();
+  std::vector<Factor> factors;
+  factors.push_back({std::shared_ptr<ceres::CostFunction>(PoseChangeFactor::Create(S)), nullptr,
+                     {blocks[0].data(), blocks[1].data(), blocks[2].data()}});
+  factors.push_back({std::shared_ptr<ceres::CostFunction>(OdometryFactor::Create(error(rng), randomSqrtInfo(rng))),
+                     nullptr, {blocks[1].data(), blocks[2].data()}});
+  factors.push_back({std::shared_ptr<ceres::CostFunction>(MarginalizationPrior::CreatePosePrior(
+                         plus(fromBlock(blocks[1].data()), Vector6::Constant(0.02)), randomSqrtInfo(rng))),
+                     nullptr, {blocks[1].data()}});
+  std::vector<const Factor*> all;
+  for (const Factor& f : factors) all.push_back(&f);
+  Marginalizer marginalizer;
+  const auto full = marginalizer.marginalize(all, {}, {});
+  const std::unordered_set<const double*> leaving{blocks[0].data()};
+  const auto reduced = marginalizer.marginalize(all, leaving, {});
+  ASSERT_TRUE(full && reduced);
+  Eigen::MatrixXd Hmm, Hr;
+  Eigen::VectorXd g, gr;
+  dynamic_cast<const MarginalizationPrior&>(*full->cost).linearize(full->blocks.data(), Hmm, g);
+  ASSERT_EQ(full->blocks[0], blocks[0].data());
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(Hmm.topLeftCorner(6, 6)));
+  ASSERT_LT(es.eigenvalues()(0), 1e-9 * es.eigenvalues()(5));  // singular indeed
+  dynamic_cast<const MarginalizationPrior&>(*reduced->cost).linearize(reduced->blocks.data(), Hr, gr);
+  const auto [expected_H, expected_g] = expectedSchur(*full, *reduced, leaving);
+  EXPECT_TRUE(Hr.isApprox(expected_H, 1e-6));
+  EXPECT_TRUE(gr.isApprox(expected_g, 1e-6));
+  EXPECT_TRUE(Hr.allFinite() && gr.allFinite());
 }
 
 // The CPU-specific kernels against Eigen's own algorithms.
@@ -405,12 +466,50 @@ TEST(BackendDenseKernels, MatchEigen) {
   EXPECT_TRUE((L_ref.transpose() * X).isApprox(B, 1e-12));
   const Eigen::MatrixXd Y = Eigen::MatrixXd::Random(9, n);
   Eigen::MatrixXd S = A;
-  dense::subtractGram(Y, S);
+  dense::subtractGramRows(dense::RowMatrix(Y), S);
   const Eigen::MatrixXd expected = A - Y.transpose() * Y;
   EXPECT_TRUE(Eigen::MatrixXd(S.triangularView<Eigen::Lower>()).isApprox(Eigen::MatrixXd(expected.triangularView<Eigen::Lower>()), 1e-12));
-  S = A;
-  dense::subtractGramRows(dense::RowMatrix(Y), S);
-  EXPECT_TRUE(Eigen::MatrixXd(S.triangularView<Eigen::Lower>()).isApprox(Eigen::MatrixXd(expected.triangularView<Eigen::Lower>()), 1e-12));
+  const Eigen::MatrixXd Z = Eigen::MatrixXd::Random(9, m);
+  Eigen::MatrixXd C = B;
+  dense::subtractProductTN(Y, Z, C);
+  EXPECT_TRUE(C.isApprox(B - Y.transpose() * Z, 1e-12));
+}
+
+// The band kernels against a dense factorization of the same matrix: 7 blocks of 6, bandwidth
+// 2, damping on the diagonal; the staircase solve touches only the columns it is given.
+TEST(BackendDenseKernels, BandMatchesDense) {
+  const int m = 7, w = 2, n = 6 * m;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < m; ++i)
+    for (int j = std::max(0, i - w); j <= i; ++j) A.block<6, 6>(6 * i, 6 * j) = Eigen::MatrixXd::Random(6, 6);
+  A = (A * A.transpose()).eval();  // banded: products of lower-banded factors keep 2w blocks
+  Eigen::MatrixXd band_full = Eigen::MatrixXd::Zero(n, n);
+  const int bw = 2 * w;
+  std::vector<Matrix6> H(m * (bw + 1), Matrix6::Zero());
+  for (int i = 0; i < m; ++i)
+    for (int d = 0; d <= std::min(i, bw); ++d) H[i * (bw + 1) + d] = A.block<6, 6>(6 * i, 6 * (i - d));
+  const Eigen::VectorXd damping = Eigen::VectorXd::Constant(n, 0.5);
+  std::vector<Matrix6> L, L_inv;
+  ASSERT_TRUE(dense::bandCholesky(H, m, bw, damping, L, L_inv));
+  Eigen::MatrixXd damped = A;
+  damped.diagonal() += damping;
+  const Eigen::MatrixXd L_ref = damped.llt().matrixL();
+  for (int i = 0; i < m; ++i)
+    for (int d = 0; d <= std::min(i, bw); ++d)
+      EXPECT_TRUE(L[i * (bw + 1) + d].isApprox(L_ref.block<6, 6>(6 * i, 6 * (i - d)), 1e-10)) << i << " " << d;
+  // A staircase right-hand side: block row i is non-zero in its first widths[i] columns.
+  const std::vector<int> widths = {2, 2, 3, 3, 5, 5, 5};
+  dense::RowMatrix Bm = dense::RowMatrix::Zero(n, 5);
+  for (int i = 0; i < m; ++i) Bm.block(6 * i, 0, 6, widths[i]).setRandom();
+  const Eigen::MatrixXd B0 = Bm;
+  dense::bandSolveLower(L, L_inv, bw, Bm, &widths);
+  EXPECT_TRUE((L_ref * Eigen::MatrixXd(Bm)).isApprox(B0, 1e-10));
+  dense::bandSolveLowerTransposed(L, L_inv, bw, Bm);
+  EXPECT_TRUE((damped * Eigen::MatrixXd(Bm)).isApprox(B0, 1e-10));
+  Matrix6 not_definite = -Matrix6::Identity();
+  std::vector<Matrix6> H_bad(m * (bw + 1), Matrix6::Zero());
+  for (int i = 0; i < m; ++i) H_bad[i * (bw + 1)] = i == 3 ? not_definite : Matrix6::Identity();
+  EXPECT_FALSE(dense::bandCholesky(H_bad, m, bw, Eigen::VectorXd::Zero(n), L, L_inv));
 }
 
 TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {

@@ -52,12 +52,12 @@ void solveLowerTransposed(const double* L, int n, int ldl, double* B, int m, int
   Lm.triangularView<Eigen::Lower>().transpose().solveInPlace(Bm);
 }
 
-void subtractGram(const double* Y, int k, int n, int ldy, double* S, int lds) {
-  Map(S, n, n, Stride(lds)).selfadjointView<Eigen::Lower>().rankUpdate(ConstMap(Y, k, n, Stride(ldy)).transpose(), -1.0);
-}
-
 void subtractOuter(const double* X, int n, int k, int ldx, double* S, int lds) {
   Map(S, n, n, Stride(lds)).selfadjointView<Eigen::Lower>().rankUpdate(ConstMap(X, n, k, Stride(ldx)), -1.0);
+}
+
+void subtractProductTN(const double* A, int k, int m, int lda, const double* B, int n, int ldb, double* C, int ldc) {
+  Map(C, m, n, Stride(ldc)).noalias() -= ConstMap(A, k, m, Stride(lda)).transpose() * ConstMap(B, k, n, Stride(ldb));
 }
 
 // Row by row of blocks: L(i,j) = (H(i,j) - sum_k L(i,k) L(j,k)^T) L(j,j)^-T for j < i, and

@@ -22,8 +22,9 @@ namespace raw {
 DLSLOT_DENSE_API bool cholesky(double* A, int n, int lda);
 DLSLOT_DENSE_API void solveLower(const double* L, int n, int ldl, double* B, int m, int ldb);
 DLSLOT_DENSE_API void solveLowerTransposed(const double* L, int n, int ldl, double* B, int m, int ldb);
-DLSLOT_DENSE_API void subtractGram(const double* Y, int k, int n, int ldy, double* S, int lds);
 DLSLOT_DENSE_API void subtractOuter(const double* X, int n, int k, int ldx, double* S, int lds);
+DLSLOT_DENSE_API void subtractProductTN(const double* A, int k, int m, int lda, const double* B, int n, int ldb,
+                                        double* C, int ldc);
 DLSLOT_DENSE_API bool bandCholesky(const double* H, int m, int w, const double* damping, double* L, double* L_inv);
 DLSLOT_DENSE_API void bandSolveLower(const double* L, const double* L_inv, int m, int w, double* B, int cols,
                                      const int* widths);
@@ -51,12 +52,13 @@ inline void solveLowerTransposed(ConstMatrixRef L, MatrixRef B) {
   raw::solveLowerTransposed(L.data(), static_cast<int>(L.rows()), static_cast<int>(L.outerStride()), B.data(),
                             static_cast<int>(B.cols()), static_cast<int>(B.outerStride()));
 }
-// S <- S - Y^T Y on S's lower triangle.
-inline void subtractGram(ConstMatrixRef Y, MatrixRef S) {
-  raw::subtractGram(Y.data(), static_cast<int>(Y.rows()), static_cast<int>(Y.cols()), static_cast<int>(Y.outerStride()),
-                    S.data(), static_cast<int>(S.outerStride()));
+// C <- C - A^T B.
+inline void subtractProductTN(ConstMatrixRef A, ConstMatrixRef B, MatrixRef C) {
+  raw::subtractProductTN(A.data(), static_cast<int>(A.rows()), static_cast<int>(A.cols()),
+                         static_cast<int>(A.outerStride()), B.data(), static_cast<int>(B.cols()),
+                         static_cast<int>(B.outerStride()), C.data(), static_cast<int>(C.outerStride()));
 }
-// subtractGram for a row-major Y (whose storage is Y^T column-major).
+// S <- S - Y^T Y on S's lower triangle, for a row-major Y (whose storage is Y^T column-major).
 inline void subtractGramRows(const RowMatrix& Y, MatrixRef S) {
   raw::subtractOuter(Y.data(), static_cast<int>(Y.cols()), static_cast<int>(Y.rows()), static_cast<int>(Y.cols()),
                      S.data(), static_cast<int>(S.outerStride()));

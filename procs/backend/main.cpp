@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "backend/backend_messages.hpp"
+#include "backend/heap_memory.hpp"
 #include "dlslot/frame_joiner.hpp"
 #include "backend/sliding_window.hpp"
 #include "dlslot/node.hpp"
@@ -208,6 +209,7 @@ int main(int argc, char** argv) {
     section.finish();
     if (!mode.empty()) config.mode = parseMode(mode);
     if (opts.check_config) return 0;
+    retainFreedMemory();
     if (!offline_in.empty()) return runOffline(config, channels, offline_in, offline_out);
     return runLive(config, channels, opts, join_timeout_s);
   });

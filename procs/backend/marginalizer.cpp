@@ -14,34 +14,27 @@
 namespace dlslot::backend {
 namespace {
 
+// Kept blocks per panel of the Schur complement's solves and products: wide enough for the
+// dense kernels to run near their peak, narrow enough that few zeros above the staircase are
+// worked on and that two threads have several panels to share.
+constexpr int kPanelBlocks = 4;
+
 // H* = H_rr - H_rm H_mm^-1 H_mr and g* = g_r - H_rm H_mm^-1 g_m, in place: on entry H_mm,
 // H_mr, H_rr (lower triangle) and g_m, g_r; on exit H_rr holds H* and g_r holds g*, the others
 // are used up. With H_mm = L L^T and Y = L^-1 H_mr: H* = H_rr - Y^T Y, g* = g_r - Y^T L^-1 g_m.
-// Kept block c's column of H_mr is zero above first_row[c] (non-decreasing), so is Y's: each
-// group of columns is solved with the trailing part of L only (the groups in parallel), and
-// Y^T Y is summed over bands of rows, each with the columns that are non-zero there. A
-// singular H_mm (a direction no factor constrains, which carries no information to pass on)
-// falls back to the pseudo-inverse.
+// Kept block c's column of H_mr is zero above first_row[c] (non-decreasing), so is Y's. The
+// kept blocks are taken in panels: a panel's columns of Y are solved with L's trailing part
+// from its first row p only, and its rows of Y^T Y summed over Y's rows from p only (the
+// panels in parallel). A singular H_mm (a direction no factor constrains, which carries
+// no information to pass on) falls back to the pseudo-inverse.
 void schurComplement(Eigen::MatrixXd& H_mm, Eigen::MatrixXd& H_mr, Eigen::MatrixXd& H_rr, Eigen::VectorXd& g_m,
                      Eigen::VectorXd& g_r, std::vector<int> first_row, ParallelFor* parallel) {
   const int nm = static_cast<int>(H_mm.rows()), kept = static_cast<int>(H_rr.rows()) / 6;
   Eigen::MatrixXd& L = H_mm;
   Eigen::MatrixXd& Y = H_mr;
   const Eigen::VectorXd diagonal = H_mm.diagonal();
-  if (dense::cholesky(L)) {
-    std::vector<std::pair<int, int>> column_groups;  // [c0, c1): blocks with the same first row
-    for (int c0 = 0, c1 = 0; c0 < kept; c0 = c1) {
-      while (c1 < kept && first_row[c1] == first_row[c0]) ++c1;
-      if (first_row[c0] < nm) column_groups.emplace_back(c0, c1);
-    }
-    auto solve = [&](int k) {
-      const auto [c0, c1] = column_groups[k];
-      const int p = first_row[c0];
-      dense::solveLower(L.bottomRightCorner(nm - p, nm - p), Y.block(p, 6 * c0, nm - p, 6 * (c1 - c0)));
-    };
-    parallelFor(parallel, static_cast<int>(column_groups.size()), solve);
-    dense::solveLower(L, g_m);
-  } else {
+  const bool definite = dense::cholesky(L);
+  if (!definite) {
     // The Cholesky left the upper triangle alone: H_mm is still there, but for its diagonal.
     // (The eigen solver reads the lower triangle.)
     Eigen::MatrixXd H = H_mm.transpose();
@@ -54,13 +47,30 @@ void schurComplement(Eigen::MatrixXd& H_mm, Eigen::MatrixXd& H_mr, Eigen::Matrix
     g_m = inv_sqrt.asDiagonal() * (es.eigenvectors().transpose() * g_m);
     first_row.assign(kept, 0);  // Y is full now
   }
-  // Rows [p, next p) are non-zero in the columns of the blocks with first_row <= p only.
-  for (int c = 0; c < kept && first_row[c] < nm;) {
-    const int p = first_row[c];
-    while (c < kept && first_row[c] == p) ++c;
-    const int end = c < kept ? std::min(first_row[c], nm) : nm;
-    dense::subtractGram(Y.block(p, 0, end - p, 6 * c), H_rr.topLeftCorner(6 * c, 6 * c));
+  // Panels of kept blocks [c0, c1): rows from first_row[c0] on hold all their non-zeros.
+  std::vector<std::pair<int, int>> panels;
+  for (int c0 = 0; c0 < kept && first_row[c0] < nm; c0 += kPanelBlocks) {
+    int c1 = std::min(c0 + kPanelBlocks, kept);
+    while (first_row[c1 - 1] >= nm) --c1;
+    panels.emplace_back(c0, c1);
   }
+  const int n_panels = static_cast<int>(panels.size());
+  if (definite) {
+    parallelFor(parallel, n_panels, [&](int k) {
+      const auto [c0, c1] = panels[k];
+      const int p = first_row[c0];
+      dense::solveLower(L.bottomRightCorner(nm - p, nm - p), Y.block(p, 6 * c0, nm - p, 6 * (c1 - c0)));
+    });
+    dense::solveLower(L, g_m);
+  }
+  // The panel's rows of Y^T Y up to its last column (those right of the diagonal are not used:
+  // H_rr's lower triangle is what counts).
+  parallelFor(parallel, n_panels, [&](int k) {
+    const auto [c0, c1] = panels[k];
+    const int p = first_row[c0];
+    dense::subtractProductTN(Y.block(p, 6 * c0, nm - p, 6 * (c1 - c0)), Y.block(p, 0, nm - p, 6 * c1),
+                             H_rr.block(6 * c0, 0, 6 * (c1 - c0), 6 * c1));
+  });
   g_r.noalias() -= Y.transpose() * g_m;
 }
 
@@ -94,10 +104,16 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
   // first leaving block they share a factor with (first_row; none: after all). A kept block is
   // coupled to few leaving ones (an object's next pose and change to its last ones), so its
   // columns of H_mr, and of L^-1 H_mr, are zero above that row: a staircase the Schur
-  // complement exploits.
+  // complement exploits. The priors' leaving blocks come first, in the prior's own order: its
+  // Hessian is then one block of H_mm when all its blocks leave (the usual slide).
   std::vector<double*> order;
   std::unordered_map<const double*, int> index;
+  std::vector<const Factor*> priors_first;
   for (const Factor* f : factors)
+    if (dynamic_cast<const MarginalizationPrior*>(f->cost.get())) priors_first.push_back(f);
+  for (const Factor* f : factors)
+    if (!dynamic_cast<const MarginalizationPrior*>(f->cost.get())) priors_first.push_back(f);
+  for (const Factor* f : priors_first)
     for (double* b : f->blocks)
       if (!fixed.count(b) && leaving.count(b) && !index.count(b)) {
         index[b] = static_cast<int>(order.size());
@@ -149,6 +165,13 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
     const int nb = static_cast<int>(f->blocks.size());
     std::vector<int> at(nb);
     for (int k = 0; k < nb; ++k) at[k] = fixed.count(f->blocks[k]) ? -1 : 6 * index.at(f->blocks[k]);
+    bool contiguous = at[0] >= 0 && at[0] + 6 * nb <= nm;  // all leaving, in order
+    for (int k = 1; k < nb && contiguous; ++k) contiguous = at[k] == at[k - 1] + 6;
+    if (contiguous) {
+      H_mm.block(at[0], at[0], 6 * nb, 6 * nb) += Hf[i];
+      for (int a = 0; a < nb; ++a) g_m.segment<6>(at[a]) += lin[i].gradientBlock(a);
+      continue;
+    }
     for (int a = 0; a < nb; ++a) {
       if (at[a] < 0) continue;
       (at[a] < nm ? g_m.segment<6>(at[a]) : g_star.segment<6>(at[a] - nm)) += lin[i].gradientBlock(a);

@@ -506,6 +506,12 @@ TEST(BackendDenseKernels, BandMatchesDense) {
   EXPECT_TRUE((L_ref * Eigen::MatrixXd(Bm)).isApprox(B0, 1e-10));
   dense::bandSolveLowerTransposed(L, L_inv, bw, Bm);
   EXPECT_TRUE((damped * Eigen::MatrixXd(Bm)).isApprox(B0, 1e-10));
+  dense::RowMatrix v = dense::RowMatrix::Random(n, 1);  // a vector takes a path of its own
+  const Eigen::VectorXd v0 = v;
+  dense::bandSolveLower(L, L_inv, bw, v);
+  EXPECT_TRUE((L_ref * Eigen::VectorXd(v)).isApprox(v0, 1e-10));
+  dense::bandSolveLowerTransposed(L, L_inv, bw, v);
+  EXPECT_TRUE((damped * Eigen::VectorXd(v)).isApprox(v0, 1e-10));
   Matrix6 not_definite = -Matrix6::Identity();
   std::vector<Matrix6> H_bad(m * (bw + 1), Matrix6::Zero());
   for (int i = 0; i < m; ++i) H_bad[i * (bw + 1)] = i == 3 ? not_definite : Matrix6::Identity();

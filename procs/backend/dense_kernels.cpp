@@ -12,6 +12,7 @@ using Map = Eigen::Map<Eigen::MatrixXd, 0, Stride>;
 using ConstMap = Eigen::Map<const Eigen::MatrixXd, 0, Stride>;
 using Block6 = Eigen::Map<Eigen::Matrix<double, 6, 6>>;
 using ConstBlock6 = Eigen::Map<const Eigen::Matrix<double, 6, 6>>;
+using Vector6Map = Eigen::Map<Eigen::Matrix<double, 6, 1>>;
 using Rows6 = Eigen::Map<Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>, 0, Stride>;
 using ConstRows6 = Eigen::Map<const Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>, 0, Stride>;
 
@@ -84,6 +85,14 @@ bool bandCholesky(const double* H, int m, int w, const double* damping, double* 
 }
 
 void bandSolveLower(const double* L, const double* L_inv, int m, int w, double* B, int cols, const int* widths) {
+  if (cols == 1) {  // a vector (the gradient): fixed-size products
+    for (int i = 0; i < m; ++i) {
+      Vector6Map b(B + 6 * i);
+      for (int k = std::max(0, i - w); k < i; ++k) b.noalias() -= ConstBlock6(L + 36 * (i * (w + 1) + i - k)) * Vector6Map(B + 6 * k);
+      b = (ConstBlock6(L_inv + 36 * i) * b).eval();
+    }
+    return;
+  }
   Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor> tmp;
   for (int i = 0; i < m; ++i) {
     const int n = widths ? widths[i] : cols;
@@ -95,6 +104,15 @@ void bandSolveLower(const double* L, const double* L_inv, int m, int w, double* 
 }
 
 void bandSolveLowerTransposed(const double* L, const double* L_inv, int m, int w, double* B, int cols) {
+  if (cols == 1) {
+    for (int i = m - 1; i >= 0; --i) {
+      Vector6Map b(B + 6 * i);
+      for (int k = i + 1; k <= std::min(m - 1, i + w); ++k)
+        b.noalias() -= ConstBlock6(L + 36 * (k * (w + 1) + k - i)).transpose() * Vector6Map(B + 6 * k);
+      b = (ConstBlock6(L_inv + 36 * i).transpose() * b).eval();
+    }
+    return;
+  }
   Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor> tmp;
   for (int i = m - 1; i >= 0; --i) {
     Rows6 Bi(B + 6 * i * cols, 6, cols, Stride(cols));

@@ -34,7 +34,6 @@ void WindowSolver::BandCholesky::solveLt(RowMatrix& B) const { dense::bandSolveL
 void WindowSolver::setUp(const std::vector<double*>& separator, const std::vector<std::vector<double*>>& groups,
                          const std::unordered_set<const double*>& fixed, int tail) {
   separator_.clear();
-  groups_.clear();
   where_.clear();
   tail_dim_ = 0;
   tail_cov_.resize(0, 0);
@@ -45,16 +44,24 @@ void WindowSolver::setUp(const std::vector<double*>& separator, const std::vecto
     if (static_cast<int>(i) >= static_cast<int>(separator.size()) - tail) tail_dim_ += 6;
   }
   n_sep_ = 6 * static_cast<int>(separator_.size());
+  // The groups' matrices keep their storage from the last solve (the window changes little
+  // from frame to frame, so their sizes mostly stay): no reallocation, and warm caches.
+  int k = 0;
   for (const auto& blocks : groups) {
-    Group g;
+    if (k == static_cast<int>(groups_.size())) groups_.emplace_back();
+    Group& g = groups_[k];
+    g.blocks.clear();
+    g.factors.clear();
+    g.w = 0;
     for (double* b : blocks) {
       if (fixed.count(b)) continue;
-      where_[b] = Slot{static_cast<int>(groups_.size()), static_cast<int>(g.blocks.size())};
+      where_[b] = Slot{k, static_cast<int>(g.blocks.size())};
       g.blocks.push_back(b);
     }
     g.m = static_cast<int>(g.blocks.size());
-    if (g.m > 0) groups_.push_back(std::move(g));
+    if (g.m > 0) ++k;
   }
+  groups_.resize(k);
 }
 
 void WindowSolver::mapFactors(const std::vector<const Factor*>& factors) {
@@ -212,7 +219,12 @@ bool WindowSolver::factor(double mu) {
   factored_linearization_ = -1;  // until it succeeds
   std::vector<char> ok(groups_.size());
   forEachItem([&](int item) {
-    if (item == 0) return;
+    if (item == 0) {
+      // The separator's own part, damped, while the groups are being eliminated.
+      H_reduced_ = H_sep_;
+      for (int i = 0; i < n_sep_; ++i) H_reduced_(i, i) += damping(diag_sep_(i), mu);
+      return;
+    }
     Group& grp = groups_[item - 1];
     ok[item - 1] = grp.chol.compute(grp.H, grp.m, grp.w, mu);
     if (!ok[item - 1]) return;
@@ -225,12 +237,10 @@ bool WindowSolver::factor(double mu) {
   factored_linearization_ = linearizations_;
   // Lower triangles only: touched is in separator order, so S's lower blocks land in
   // H_reduced_'s lower triangle, the only one the Cholesky reads.
-  H_reduced_ = H_sep_;
   for (const Group& grp : groups_)
     for (size_t a = 0; a < grp.touched.size(); ++a)
       for (size_t b = 0; b <= a; ++b)
         H_reduced_.block<6, 6>(6 * grp.touched[a], 6 * grp.touched[b]) += grp.S.block<6, 6>(6 * a, 6 * b);
-  for (int i = 0; i < n_sep_; ++i) H_reduced_(i, i) += damping(diag_sep_(i), mu);
   return n_sep_ == 0 || dense::cholesky(H_reduced_);
 }
 

@@ -153,8 +153,8 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
       g.g.setZero(6 * g.m);
       g.g_touched.setZero(nc);
       g.H.assign(g.m * (g.w + 1), Matrix6::Zero());
-      g.C.setZero(6 * g.m, nc);
-      g.D.setZero(nc, nc);
+      g.Y.setZero(6 * g.m, nc);
+      g.S.setZero(nc, nc);
     }
     for (int i : itemFactors(item)) {
       FactorLinearization& lin = lin_[i];
@@ -185,9 +185,9 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
           if (sa.group >= 0 && sb.group >= 0) {
             if (sb.index <= sa.index) g.H[sa.index * (g.w + 1) + (sa.index - sb.index)] += block;
           } else if (sa.group >= 0) {
-            g.C.block<6, 6>(6 * sa.index, sb.column) += block;
+            g.Y.block<6, 6>(6 * sa.index, sb.column) += block;
           } else if (sb.group == -1 && sb.column <= sa.column) {
-            g.D.block<6, 6>(sa.column, sb.column) += block;
+            g.S.block<6, 6>(sa.column, sb.column) += block;
           }  // (separator, group): the transpose of C; the band and D keep lower halves
         }
       }
@@ -198,7 +198,7 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
   for (const Group& g : groups_)
     for (size_t a = 0; a < g.touched.size(); ++a) {
       g_sep_.segment<6>(6 * g.touched[a]) += g.g_touched.segment<6>(6 * a);
-      diag_sep_.segment<6>(6 * g.touched[a]) += g.D.diagonal().segment<6>(6 * a);
+      diag_sep_.segment<6>(6 * g.touched[a]) += g.S.diagonal().segment<6>(6 * a);
     }
   max_gradient_ = n_sep_ > 0 ? g_sep_.cwiseAbs().maxCoeff() : 0.0;
   for (const Group& g : groups_) max_gradient_ = std::max(max_gradient_, g.g.cwiseAbs().maxCoeff());
@@ -228,9 +228,7 @@ bool WindowSolver::factor(double mu) {
     Group& grp = groups_[item - 1];
     ok[item - 1] = grp.chol.compute(grp.H, grp.m, grp.w, mu);
     if (!ok[item - 1]) return;
-    grp.Y = grp.C;
     grp.chol.solveL(grp.Y, &grp.widths);
-    grp.S = grp.D;
     dense::subtractGramRows(grp.Y, grp.S);
   });
   if (std::find(ok.begin(), ok.end(), 0) != ok.end()) return false;
@@ -323,6 +321,7 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
     if (!factor(1.0 / radius)) {
       radius /= decrease_factor;
       decrease_factor *= 2;
+      linearizeAll(factors, fixed);  // the failed factorization used it up
       continue;
     }
     factored_mu = 1.0 / radius;
@@ -403,15 +402,16 @@ std::optional<Matrix6> WindowSolver::covariance(const double* block) const {
       tail_offsets.push_back(6 * g.touched[a] - tail_start);
     }
   if (cols.empty()) return cov;
-  RowMatrix C(6 * g.m, 6 * cols.size());
+  RowMatrix W(6 * g.m, 6 * cols.size());  // H_k^-1 C = L^-T Y over the tail columns
   Eigen::MatrixXd Sigma(6 * cols.size(), 6 * cols.size());
   for (size_t a = 0; a < cols.size(); ++a) {
-    C.middleCols<6>(6 * a) = g.C.middleCols<6>(cols[a]);
+    W.middleCols<6>(6 * a) = g.Y.middleCols<6>(cols[a]);
     for (size_t b = 0; b < cols.size(); ++b)
       Sigma.block<6, 6>(6 * a, 6 * b) = tail_cov_.block<6, 6>(tail_offsets[a], tail_offsets[b]);
   }
-  const Eigen::MatrixXd W = solve(C).middleRows<6>(6 * s.index);
-  cov += W * Sigma * W.transpose();
+  g.chol.solveLt(W);
+  const Eigen::MatrixXd W_b = W.middleRows<6>(6 * s.index);
+  cov += W_b * Sigma * W_b.transpose();
   return cov;
 }
 

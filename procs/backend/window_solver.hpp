@@ -78,16 +78,16 @@ class WindowSolver {
     std::vector<int> factors;     // indices of the factors touching them
     int m = 0, w = 0;             // blocks, block bandwidth
     std::vector<Matrix6> H;       // undamped band (BandCholesky layout)
-    RowMatrix C;                  // 6m x 6|touched|: coupling to the touched separator blocks
-    Eigen::MatrixXd D;            // the factors' Hessian among the touched blocks (lower blocks)
     Eigen::VectorXd g, g_touched;  // gradient on the group's blocks and on the touched ones
     std::vector<int> touched;     // separator block indices
     // Columns of C that can be non-zero in each block row: an ego pose X_f couples to the
     // chain from o_f on, so C (and Y) are a staircase when the touched blocks come in time order.
     std::vector<int> widths;
     BandCholesky chol;
-    RowMatrix Y;                  // L^-1 C
-    Eigen::MatrixXd S;            // D - Y^T Y: the group's Schur complement on the separator
+    // Linearized, then eliminated in place by factor() (no copies of these, the largest of a
+    // group's matrices):
+    RowMatrix Y;        // 6m x 6|touched|: the coupling C to the touched separator blocks, then L^-1 C
+    Eigen::MatrixXd S;  // the factors' Hessian D among the touched blocks (lower blocks), then D - Y^T Y
     RowMatrix z;                  // substitute(): L^-1 g, then the step
     Eigen::VectorXd Ytz;          // substitute(): Y^T z
   };
@@ -95,7 +95,7 @@ class WindowSolver {
   struct Slot {
     int group = -2;   // -1: separator, -2: fixed, else the group
     int index = 0;    // block index in the separator or in the group
-    int column = -1;  // separator block of a group's factor: its column offset in the group's C
+    int column = -1;  // separator block of a group's factor: its column offset in the group's Y
   };
 
   void setUp(const std::vector<double*>& separator, const std::vector<std::vector<double*>>& groups,
@@ -115,7 +115,7 @@ class WindowSolver {
   double totalCost(const std::vector<const Factor*>& factors);
   // Factors the Hessian damped by mu (Levenberg-Marquardt, as Ceres: H + mu diag(H)): the
   // groups' band Cholesky and Schur complements, then the separator's dense Cholesky. False
-  // when one fails.
+  // when one fails. Uses up the groups' linearization (Y, S): factoring again needs a new one.
   bool factor(double mu);
   // The step for the current gradient from the last factorization, into step_sep_ and
   // step_groups_.

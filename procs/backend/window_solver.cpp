@@ -160,7 +160,13 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
       FactorLinearization& lin = lin_[i];
       linearize(*factors[i], fixed, lin);
       item_cost += lin.cost;
-      lin.hessian(Hf);
+      // The Hessian's 6x6 blocks J_a^T J_b, each formed only where it is kept (the band and
+      // the separator keep lower halves); the prior's come from its own dense Hessian.
+      if (lin.prior) lin.hessian(Hf);
+      auto hessianBlock = [&](int a, int b) -> Matrix6 {
+        if (lin.prior) return Hf.block<6, 6>(6 * a, 6 * b);
+        return lin.J[a].transpose() * lin.J[b];
+      };
       const std::vector<Slot>& slots = slots_[i];
       const int nb = static_cast<int>(slots.size());
       for (int a = 0; a < nb; ++a) {
@@ -169,7 +175,8 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
         if (item == 0) {
           g_sep_.segment<6>(6 * sa.index) += lin.gradientBlock(a);
           for (int b = 0; b < nb; ++b)
-            if (slots[b].group == -1) H_sep_.block<6, 6>(6 * sa.index, 6 * slots[b].index) += Hf.block<6, 6>(6 * a, 6 * b);
+            if (slots[b].group == -1 && slots[b].index <= sa.index)
+              H_sep_.block<6, 6>(6 * sa.index, 6 * slots[b].index) += hessianBlock(a, b);
           continue;
         }
         Group& g = groups_[item - 1];
@@ -180,14 +187,13 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
         }
         for (int b = 0; b < nb; ++b) {
           const Slot& sb = slots[b];
-          const auto block = Hf.block<6, 6>(6 * a, 6 * b);
           if (sb.group == -2) continue;
           if (sa.group >= 0 && sb.group >= 0) {
-            if (sb.index <= sa.index) g.H[sa.index * (g.w + 1) + (sa.index - sb.index)] += block;
+            if (sb.index <= sa.index) g.H[sa.index * (g.w + 1) + (sa.index - sb.index)] += hessianBlock(a, b);
           } else if (sa.group >= 0) {
-            g.Y.block<6, 6>(6 * sa.index, sb.column) += block;
+            g.Y.block<6, 6>(6 * sa.index, sb.column) += hessianBlock(a, b);
           } else if (sb.group == -1 && sb.column <= sa.column) {
-            g.S.block<6, 6>(sa.column, sb.column) += block;
+            g.S.block<6, 6>(sa.column, sb.column) += hessianBlock(a, b);
           }  // (separator, group): the transpose of C; the band and D keep lower halves
         }
       }

@@ -50,13 +50,23 @@ double MarginalizationPrior::gradient(double const* const* x, std::vector<Matrix
   return half_r0_squared_ + 0.5 * dx.dot(Jtr0_ + g0);
 }
 
+Matrix6 MarginalizationPrior::hessianBlock(const std::vector<Matrix6>& M, int i, int j) const {
+  // M_i = blockdiag(I, R_i) (minusJacobianAt): only the rotation rows and columns change.
+  const Eigen::Matrix3d Ri = M[i].bottomRightCorner<3, 3>(), Rj = M[j].bottomRightCorner<3, 3>();
+  const auto H = JtJ_.block<6, 6>(6 * i, 6 * j);
+  Matrix6 out;
+  out.topLeftCorner<3, 3>() = H.topLeftCorner<3, 3>();
+  out.topRightCorner<3, 3>().noalias() = H.topRightCorner<3, 3>() * Rj;
+  out.bottomLeftCorner<3, 3>().noalias() = Ri.transpose() * H.bottomLeftCorner<3, 3>();
+  out.bottomRightCorner<3, 3>().noalias() = Ri.transpose() * H.bottomRightCorner<3, 3>() * Rj;
+  return out;
+}
+
 void MarginalizationPrior::hessian(const std::vector<Matrix6>& M, Eigen::MatrixXd& H) const {
-  // M_i = blockdiag(I, R_i) (minusJacobianAt): only the rotation columns and rows change.
-  H = JtJ_;
-  for (int j = 0; j < numBlocks(); ++j)
-    H.middleCols<3>(6 * j + 3) = (H.middleCols<3>(6 * j + 3) * M[j].bottomRightCorner<3, 3>()).eval();
-  for (int i = 0; i < numBlocks(); ++i)
-    H.middleRows<3>(6 * i + 3) = (M[i].bottomRightCorner<3, 3>().transpose() * H.middleRows<3>(6 * i + 3)).eval();
+  const int n = numBlocks();
+  H.resize(6 * n, 6 * n);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) H.block<6, 6>(6 * i, 6 * j) = hessianBlock(M, i, j);
 }
 
 void MarginalizationPrior::linearize(double const* const* x, Eigen::MatrixXd& H, Eigen::VectorXd& g) const {

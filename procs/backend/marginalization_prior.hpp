@@ -32,6 +32,8 @@ class MarginalizationPrior final : public ceres::CostFunction {
   // cost 0.5 |r(x)|^2 = 0.5 |r0|^2 + 0.5 dx . (J^T r0 + J^T J dx + J^T r0), dx = x [-] x_lin.
   double gradient(double const* const* x, std::vector<Matrix6>& M, Eigen::VectorXd& g) const;
   void hessian(const std::vector<Matrix6>& M, Eigen::MatrixXd& H) const;
+  // Its 6x6 block (i, j), for solvers that keep only some blocks.
+  Matrix6 hessianBlock(const std::vector<Matrix6>& M, int i, int j) const;
   // The whole H = Jx^T Jx and g = Jx^T r(x) (for tests and small priors).
   void linearize(double const* const* x, Eigen::MatrixXd& H, Eigen::VectorXd& g) const;
   // |Jx dx|^2 for a tangent step dx over every block.

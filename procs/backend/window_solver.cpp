@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "backend/dense_kernels.hpp"
+#include "backend/marginalization_prior.hpp"
 #include "backend/pose_manifold.hpp"
 
 namespace dlslot::backend {
@@ -142,7 +143,6 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
   ++linearizations_;
   lin_.resize(factors.size());
   const double cost = sumOverItems([&](int item) {
-    Eigen::MatrixXd Hf;
     double item_cost = 0;
     if (item == 0) {
       g_sep_.setZero(n_sep_);
@@ -160,11 +160,10 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
       FactorLinearization& lin = lin_[i];
       linearize(*factors[i], fixed, lin);
       item_cost += lin.cost;
-      // The Hessian's 6x6 blocks J_a^T J_b, each formed only where it is kept (the band and
-      // the separator keep lower halves); the prior's come from its own dense Hessian.
-      if (lin.prior) lin.hessian(Hf);
+      // The Hessian's 6x6 blocks, each formed only where it is kept (the band and the
+      // separator keep lower halves).
       auto hessianBlock = [&](int a, int b) -> Matrix6 {
-        if (lin.prior) return Hf.block<6, 6>(6 * a, 6 * b);
+        if (lin.prior) return lin.prior->hessianBlock(lin.M, a, b);
         return lin.J[a].transpose() * lin.J[b];
       };
       const std::vector<Slot>& slots = slots_[i];

@@ -24,13 +24,21 @@ void subtractProduct(const Eigen::Matrix<double, 6, 6>& A, const ConstRows6& X, 
                 A(r, 4) * X.row(4) + A(r, 5) * X.row(5);
 }
 
-// B <- A B for a 6x6 A (through a copy of B).
-void multiplyInPlace(const Eigen::Matrix<double, 6, 6>& A, Rows6& B, Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>& tmp) {
-  tmp = B;
-  const ConstRows6 X(tmp.data(), 6, tmp.cols(), Stride(tmp.cols()));
-  for (int r = 0; r < 6; ++r)
-    B.row(r) = A(r, 0) * X.row(0) + A(r, 1) * X.row(1) + A(r, 2) * X.row(2) + A(r, 3) * X.row(3) +
-               A(r, 4) * X.row(4) + A(r, 5) * X.row(5);
+// B <- A B for a lower triangular 6x6 A, in place: row r needs rows c <= r only, so the rows
+// are replaced from the last one up.
+void multiplyLowerInPlace(const Eigen::Matrix<double, 6, 6>& A, Rows6& B) {
+  for (int r = 5; r >= 0; --r) {
+    B.row(r) *= A(r, r);
+    for (int c = 0; c < r; ++c) B.row(r) += A(r, c) * B.row(c);
+  }
+}
+
+// B <- A B for an upper triangular 6x6 A, in place (rows from the first one down).
+void multiplyUpperInPlace(const Eigen::Matrix<double, 6, 6>& A, Rows6& B) {
+  for (int r = 0; r < 6; ++r) {
+    B.row(r) *= A(r, r);
+    for (int c = r + 1; c < 6; ++c) B.row(r) += A(r, c) * B.row(c);
+  }
 }
 
 }  // namespace
@@ -93,13 +101,12 @@ void bandSolveLower(const double* L, const double* L_inv, int m, int w, double* 
     }
     return;
   }
-  Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor> tmp;
   for (int i = 0; i < m; ++i) {
     const int n = widths ? widths[i] : cols;
     Rows6 Bi(B + 6 * i * cols, 6, n, Stride(cols));
     for (int k = std::max(0, i - w); k < i; ++k)
       subtractProduct(ConstBlock6(L + 36 * (i * (w + 1) + i - k)), ConstRows6(B + 6 * k * cols, 6, n, Stride(cols)), Bi);
-    multiplyInPlace(ConstBlock6(L_inv + 36 * i), Bi, tmp);
+    multiplyLowerInPlace(ConstBlock6(L_inv + 36 * i), Bi);
   }
 }
 
@@ -113,12 +120,11 @@ void bandSolveLowerTransposed(const double* L, const double* L_inv, int m, int w
     }
     return;
   }
-  Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor> tmp;
   for (int i = m - 1; i >= 0; --i) {
     Rows6 Bi(B + 6 * i * cols, 6, cols, Stride(cols));
     for (int k = i + 1; k <= std::min(m - 1, i + w); ++k)
       subtractProduct(ConstBlock6(L + 36 * (k * (w + 1) + k - i)).transpose(), ConstRows6(B + 6 * k * cols, 6, cols, Stride(cols)), Bi);
-    multiplyInPlace(ConstBlock6(L_inv + 36 * i).transpose(), Bi, tmp);
+    multiplyUpperInPlace(ConstBlock6(L_inv + 36 * i).transpose(), Bi);
   }
 }
 

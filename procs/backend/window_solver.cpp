@@ -146,7 +146,8 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
     double item_cost = 0;
     if (item == 0) {
       g_sep_.setZero(n_sep_);
-      H_sep_.setZero(n_sep_, n_sep_);
+      H_sep_.resize(n_sep_, n_sep_);
+      H_sep_.triangularView<Eigen::Lower>().setZero();
     } else {
       Group& g = groups_[item - 1];
       const int nc = 6 * static_cast<int>(g.touched.size());
@@ -173,9 +174,16 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
         if (sa.group == -2) continue;
         if (item == 0) {
           g_sep_.segment<6>(6 * sa.index) += lin.gradientBlock(a);
-          for (int b = 0; b < nb; ++b)
-            if (slots[b].group == -1 && slots[b].index <= sa.index)
-              H_sep_.block<6, 6>(6 * sa.index, 6 * slots[b].index) += hessianBlock(a, b);
+          for (int b = 0; b < nb; ++b) {
+            const int ib = slots[b].index;
+            if (slots[b].group != -1 || ib > sa.index) continue;
+            auto target = H_sep_.block<6, 6>(6 * sa.index, 6 * ib);
+            if (ib < sa.index) {
+              target += hessianBlock(a, b);
+            } else {
+              target.triangularView<Eigen::Lower>() += hessianBlock(a, b);
+            }
+          }
           continue;
         }
         Group& g = groups_[item - 1];
@@ -226,7 +234,8 @@ bool WindowSolver::factor(double mu) {
   forEachItem([&](int item) {
     if (item == 0) {
       // The separator's own part, damped, while the groups are being eliminated.
-      H_reduced_ = H_sep_;
+      H_reduced_.resize(n_sep_, n_sep_);
+      H_reduced_.triangularView<Eigen::Lower>() = H_sep_;
       for (int i = 0; i < n_sep_; ++i) H_reduced_(i, i) += damping(diag_sep_(i), mu);
       return;
     }
@@ -238,12 +247,15 @@ bool WindowSolver::factor(double mu) {
   });
   if (std::find(ok.begin(), ok.end(), 0) != ok.end()) return false;
   factored_linearization_ = linearizations_;
-  // Lower triangles only: touched is in separator order, so S's lower blocks land in
-  // H_reduced_'s lower triangle, the only one the Cholesky reads.
+  // Lower triangles only (the upper one is not even initialized): touched is in separator
+  // order, so S's lower blocks land in H_reduced_'s lower triangle, all the Cholesky reads.
   for (const Group& grp : groups_)
-    for (size_t a = 0; a < grp.touched.size(); ++a)
-      for (size_t b = 0; b <= a; ++b)
+    for (size_t a = 0; a < grp.touched.size(); ++a) {
+      for (size_t b = 0; b < a; ++b)
         H_reduced_.block<6, 6>(6 * grp.touched[a], 6 * grp.touched[b]) += grp.S.block<6, 6>(6 * a, 6 * b);
+      H_reduced_.block<6, 6>(6 * grp.touched[a], 6 * grp.touched[a]).triangularView<Eigen::Lower>() +=
+          grp.S.block<6, 6>(6 * a, 6 * a);
+    }
   return n_sep_ == 0 || dense::cholesky(H_reduced_);
 }
 

@@ -132,7 +132,7 @@ class WindowSolver {
   std::vector<std::vector<Slot>> slots_;  // per factor, per block
   int n_sep_ = 0, tail_dim_ = 0;
   std::vector<FactorLinearization> lin_;
-  Eigen::MatrixXd H_sep_;  // undamped, of the separator's own factors only (lower blocks)
+  Eigen::MatrixXd H_sep_;  // undamped, of the separator's own factors only (lower triangle)
   Eigen::VectorXd g_sep_;  // of all factors
   Eigen::VectorXd diag_sep_;  // of the whole separator Hessian (H_sep_ and the groups' D), for damping
   // Damped, after them; factor() leaves the separator's Cholesky factor in its lower triangle.

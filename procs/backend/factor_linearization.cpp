@@ -62,15 +62,9 @@ Vector6 FactorLinearization::gradientBlock(int a) const {
   return J[a].transpose() * r;
 }
 
-void FactorLinearization::hessian(Eigen::MatrixXd& H) const {
-  if (prior) return prior->hessian(M, H);
-  const int nb = static_cast<int>(J.size());
-  H.resize(6 * nb, 6 * nb);
-  for (int a = 0; a < nb; ++a)
-    for (int b = 0; b <= a; ++b) {
-      H.block<6, 6>(6 * a, 6 * b).noalias() = J[a].transpose() * J[b];
-      if (b != a) H.block<6, 6>(6 * b, 6 * a) = H.block<6, 6>(6 * a, 6 * b).transpose();
-    }
+Matrix6 FactorLinearization::hessianBlock(int a, int b) const {
+  if (prior) return prior->hessianBlock(M, a, b);
+  return J[a].transpose() * J[b];
 }
 
 double FactorLinearization::modelDecrease(const std::vector<Vector6>& dx) const {

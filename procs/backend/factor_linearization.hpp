@@ -27,9 +27,9 @@ struct FactorLinearization {
   std::vector<Matrix6> M;        // prior: manifold corrections (MarginalizationPrior::gradient)
 
   Vector6 gradientBlock(int a) const;
-  // The Gauss-Newton model's Hessian J^T J over the factor's blocks (6 per block; fixed ones
-  // are not meaningful), into H.
-  void hessian(Eigen::MatrixXd& H) const;
+  // Block (a, b) of the Gauss-Newton model's Hessian J^T J (fixed blocks' are not
+  // meaningful): users form only the blocks they keep.
+  Matrix6 hessianBlock(int a, int b) const;
   // The model's predicted cost decrease for a step (per block, fixed ones ignored):
   // -(g . dx + 0.5 dx^T H dx).
   double modelDecrease(const std::vector<Vector6>& dx) const;

@@ -18,7 +18,10 @@ class MarginalizationPrior final : public ceres::CostFunction {
  public:
   // x_lin: one linearization point per block; J: rows x (6 * blocks); r0: rows. H0 = J^T J
   // and g0 = J^T r0 when the caller has them (the Marginalizer does), else computed.
-  MarginalizationPrior(std::vector<Vector7> x_lin, Eigen::MatrixXd J, Eigen::VectorXd r0,
+  // (J is kept row-major: the Marginalizer's Cholesky factor L is J^T column-major, the same
+  // storage.)
+  using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  MarginalizationPrior(std::vector<Vector7> x_lin, RowMatrix J, Eigen::VectorXd r0,
                        Eigen::MatrixXd H0 = Eigen::MatrixXd(), Eigen::VectorXd g0 = Eigen::VectorXd());
   // A prior on a single pose (e.g. the first ego pose, which fixes the gauge): r = S (x [-] x0).
   static MarginalizationPrior* CreatePosePrior(const Pose& x0, const Matrix6& sqrt_info);
@@ -45,7 +48,7 @@ class MarginalizationPrior final : public ceres::CostFunction {
 
  private:
   std::vector<Vector7> x_lin_;
-  Eigen::MatrixXd J_;
+  RowMatrix J_;
   Eigen::VectorXd r0_;
   Eigen::MatrixXd JtJ_;
   Eigen::VectorXd Jtr0_;

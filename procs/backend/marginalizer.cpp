@@ -75,11 +75,14 @@ void schurComplement(Eigen::MatrixXd& H_mm, Eigen::MatrixXd& H_mr, Eigen::Matrix
 }
 
 // H = J^T J and g = J^T r  ->  (J, r); J is upper triangular when H is definite (returns
-// true), else the eigen-decomposition without the null space (returns false).
-bool factorize(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, Eigen::MatrixXd& J, Eigen::VectorXd& r) {
-  Eigen::MatrixXd L = H;
+// true), else the eigen-decomposition without the null space (returns false). The Cholesky
+// factor L is formed in J's own storage: row-major J = L^T is column-major L.
+bool factorize(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, MarginalizationPrior::RowMatrix& J,
+               Eigen::VectorXd& r) {
+  J = Eigen::Map<const MarginalizationPrior::RowMatrix>(H.data(), H.rows(), H.cols());  // H^T = H, a plain copy
+  Eigen::Map<Eigen::MatrixXd> L(J.data(), J.rows(), J.cols());
   if (dense::cholesky(L)) {
-    J = L.triangularView<Eigen::Lower>().transpose();
+    L.triangularView<Eigen::StrictlyUpper>().setZero();
     r = g;
     dense::solveLower(L, r);
     return true;
@@ -104,16 +107,10 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
   // first leaving block they share a factor with (first_row; none: after all). A kept block is
   // coupled to few leaving ones (an object's next pose and change to its last ones), so its
   // columns of H_mr, and of L^-1 H_mr, are zero above that row: a staircase the Schur
-  // complement exploits. The priors' leaving blocks come first, in the prior's own order: its
-  // Hessian is then one block of H_mm when all its blocks leave (the usual slide).
+  // complement exploits.
   std::vector<double*> order;
   std::unordered_map<const double*, int> index;
-  std::vector<const Factor*> priors_first;
   for (const Factor* f : factors)
-    if (dynamic_cast<const MarginalizationPrior*>(f->cost.get())) priors_first.push_back(f);
-  for (const Factor* f : factors)
-    if (!dynamic_cast<const MarginalizationPrior*>(f->cost.get())) priors_first.push_back(f);
-  for (const Factor* f : priors_first)
     for (double* b : f->blocks)
       if (!fixed.count(b) && leaving.count(b) && !index.count(b)) {
         index[b] = static_cast<int>(order.size());
@@ -150,13 +147,8 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
   // Linearize every factor at the current estimate (in parallel), then sum into the blocks
   // H_mm, H_mr, H_rr (lower triangle) and g_m, g_r of the dense H, g.
   std::vector<FactorLinearization> lin(factors.size());
-  std::vector<Eigen::MatrixXd> Hf(factors.size());
-  auto linearizeFactor = [&](int i) {
-    linearize(*factors[i], fixed, lin[i]);
-    lin[i].hessian(Hf[i]);
-  };
   const int nf = static_cast<int>(factors.size());
-  parallelFor(parallel_, nf, linearizeFactor);
+  parallelFor(parallel_, nf, [&](int i) { linearize(*factors[i], fixed, lin[i]); });
   Eigen::MatrixXd H_mm = Eigen::MatrixXd::Zero(nm, nm), H_mr = Eigen::MatrixXd::Zero(nm, nr);
   Eigen::MatrixXd H_star = Eigen::MatrixXd::Zero(nr, nr);
   Eigen::VectorXd g_m = Eigen::VectorXd::Zero(nm), g_star = Eigen::VectorXd::Zero(nr);
@@ -165,25 +157,17 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
     const int nb = static_cast<int>(f->blocks.size());
     std::vector<int> at(nb);
     for (int k = 0; k < nb; ++k) at[k] = fixed.count(f->blocks[k]) ? -1 : 6 * index.at(f->blocks[k]);
-    bool contiguous = at[0] >= 0 && at[0] + 6 * nb <= nm;  // all leaving, in order
-    for (int k = 1; k < nb && contiguous; ++k) contiguous = at[k] == at[k - 1] + 6;
-    if (contiguous) {
-      H_mm.block(at[0], at[0], 6 * nb, 6 * nb) += Hf[i];
-      for (int a = 0; a < nb; ++a) g_m.segment<6>(at[a]) += lin[i].gradientBlock(a);
-      continue;
-    }
     for (int a = 0; a < nb; ++a) {
       if (at[a] < 0) continue;
       (at[a] < nm ? g_m.segment<6>(at[a]) : g_star.segment<6>(at[a] - nm)) += lin[i].gradientBlock(a);
       for (int b = 0; b < nb; ++b) {
         if (at[b] < 0) continue;
-        const auto block = Hf[i].block<6, 6>(6 * a, 6 * b);
         if (at[a] < nm && at[b] < nm) {
-          H_mm.block<6, 6>(at[a], at[b]) += block;
+          H_mm.block<6, 6>(at[a], at[b]) += lin[i].hessianBlock(a, b);
         } else if (at[a] < nm) {
-          H_mr.block<6, 6>(at[a], at[b] - nm) += block;
+          H_mr.block<6, 6>(at[a], at[b] - nm) += lin[i].hessianBlock(a, b);
         } else if (at[b] >= nm && at[b] <= at[a]) {
-          H_star.block<6, 6>(at[a] - nm, at[b] - nm) += block;
+          H_star.block<6, 6>(at[a] - nm, at[b] - nm) += lin[i].hessianBlock(a, b);
         }  // (kept, leaving): the transpose of H_mr; H_rr keeps its lower triangle
       }
     }
@@ -214,7 +198,7 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
     stats_.kept_dim = 6 * static_cast<int>(kept.size());
   }
 
-  Eigen::MatrixXd J_star;
+  MarginalizationPrior::RowMatrix J_star;
   Eigen::VectorXd r_star;
   if (!factorize(H_star, g_star, J_star, r_star)) {
     H_star.resize(0, 0);  // recomputed from J* (the null space was left out)

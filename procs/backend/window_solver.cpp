@@ -6,7 +6,6 @@
 #include <stdexcept>
 
 #include "backend/dense_kernels.hpp"
-#include "backend/marginalization_prior.hpp"
 #include "backend/pose_manifold.hpp"
 
 namespace dlslot::backend {
@@ -161,12 +160,8 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
       FactorLinearization& lin = lin_[i];
       linearize(*factors[i], fixed, lin);
       item_cost += lin.cost;
-      // The Hessian's 6x6 blocks, each formed only where it is kept (the band and the
+      // The Hessian's 6x6 blocks are formed only where they are kept (the band and the
       // separator keep lower halves).
-      auto hessianBlock = [&](int a, int b) -> Matrix6 {
-        if (lin.prior) return lin.prior->hessianBlock(lin.M, a, b);
-        return lin.J[a].transpose() * lin.J[b];
-      };
       const std::vector<Slot>& slots = slots_[i];
       const int nb = static_cast<int>(slots.size());
       for (int a = 0; a < nb; ++a) {
@@ -179,9 +174,9 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
             if (slots[b].group != -1 || ib > sa.index) continue;
             auto target = H_sep_.block<6, 6>(6 * sa.index, 6 * ib);
             if (ib < sa.index) {
-              target += hessianBlock(a, b);
+              target += lin.hessianBlock(a, b);
             } else {
-              target.triangularView<Eigen::Lower>() += hessianBlock(a, b);
+              target.triangularView<Eigen::Lower>() += lin.hessianBlock(a, b);
             }
           }
           continue;
@@ -196,11 +191,11 @@ double WindowSolver::linearizeAll(const std::vector<const Factor*>& factors,
           const Slot& sb = slots[b];
           if (sb.group == -2) continue;
           if (sa.group >= 0 && sb.group >= 0) {
-            if (sb.index <= sa.index) g.H[sa.index * (g.w + 1) + (sa.index - sb.index)] += hessianBlock(a, b);
+            if (sb.index <= sa.index) g.H[sa.index * (g.w + 1) + (sa.index - sb.index)] += lin.hessianBlock(a, b);
           } else if (sa.group >= 0) {
-            g.Y.block<6, 6>(6 * sa.index, sb.column) += hessianBlock(a, b);
+            g.Y.block<6, 6>(6 * sa.index, sb.column) += lin.hessianBlock(a, b);
           } else if (sb.group == -1 && sb.column <= sa.column) {
-            g.S.block<6, 6>(sa.column, sb.column) += hessianBlock(a, b);
+            g.S.block<6, 6>(sa.column, sb.column) += lin.hessianBlock(a, b);
           }  // (separator, group): the transpose of C; the band and D keep lower halves
         }
       }

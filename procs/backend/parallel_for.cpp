@@ -22,7 +22,7 @@ constexpr auto kSpin = std::chrono::microseconds(100);
 }  // namespace
 
 ParallelFor::ParallelFor(int threads) {
-  for (int t = 1; t < threads; ++t) workers_.emplace_back([this] { workerLoop(); });
+  for (int t = 1; t < threads; ++t) workers_.emplace_back([this, t] { workerLoop(t); });
 }
 
 ParallelFor::~ParallelFor() {
@@ -35,24 +35,33 @@ ParallelFor::~ParallelFor() {
   for (std::thread& t : workers_) t.join();
 }
 
-void ParallelFor::Job::work() {
-  for (int i = next.fetch_add(1); i < n; i = next.fetch_add(1)) {
-    try {
-      (*task)(i);
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(error_mutex);
-      if (!error) error = std::current_exception();
+ParallelFor::Job::Job(const std::function<void(int)>* task_, int n_, int segments_)
+    : task(task_), n(n_), segments(segments_), next(new std::atomic<int>[segments_]) {
+  for (int s = 0; s < segments; ++s) next[s] = 0;
+}
+
+void ParallelFor::Job::work(int thread) {
+  for (int k = 0; k < segments; ++k) {
+    const int s = (thread + k) % segments;
+    const int begin = static_cast<int>(static_cast<long>(n) * s / segments);
+    const int end = static_cast<int>(static_cast<long>(n) * (s + 1) / segments);
+    for (int i = begin + next[s].fetch_add(1); i < end; i = begin + next[s].fetch_add(1)) {
+      try {
+        (*task)(i);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+      }
+      done.fetch_add(1, std::memory_order_release);
     }
-    done.fetch_add(1, std::memory_order_release);
   }
 }
 
 void ParallelFor::operator()(int n, const std::function<void(int)>& task) {
   if (n <= 0) return;
-  auto job = std::make_shared<Job>();
-  job->task = &task;
-  job->n = n;
-  if (!workers_.empty() && n > 1) {
+  const bool share = !workers_.empty() && n > 1;
+  auto job = std::make_shared<Job>(&task, n, share ? threads() : 1);
+  if (share) {
     bool notify;
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -62,13 +71,13 @@ void ParallelFor::operator()(int n, const std::function<void(int)>& task) {
     }
     if (notify) wake_.notify_all();
   }
-  job->work();
+  job->work(0);
   // The items still running are on workers: wait for them (briefly) rather than sleep.
   while (job->done.load(std::memory_order_acquire) < n) DLSLOT_CPU_RELAX();
   if (job->error) std::rethrow_exception(job->error);
 }
 
-void ParallelFor::workerLoop() {
+void ParallelFor::workerLoop(int thread) {
   unsigned seen = 0;
   for (;;) {
     const auto until = std::chrono::steady_clock::now() + kSpin;
@@ -86,7 +95,7 @@ void ParallelFor::workerLoop() {
       seen = generation_.load();
       job = job_;
     }
-    job->work();
+    job->work(thread);
   }
 }
 

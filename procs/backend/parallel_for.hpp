@@ -1,7 +1,7 @@
 // A fixed set of worker threads for the backend's loops over independent items (the objects'
 // eliminations, the factors' linearizations): the calling thread works too, so `threads` = 2
-// uses one worker. Items are handed out one at a time (objects differ in size); results go to
-// per-item slots that the caller then sums in item order, so the outcome does not depend on
+// uses one worker. Items are claimed one at a time (objects differ in size), each thread from
+// its own share first (see Job); results go to per-item slots that the caller then sums in item order, so the outcome does not depend on
 // the number of threads or on which thread ran what.
 #pragma once
 
@@ -30,15 +30,20 @@ class ParallelFor {
   void operator()(int n, const std::function<void(int)>& task);
 
  private:
+  // The items are cut into one contiguous segment per thread. A thread runs its own segment
+  // first, then helps with the others: the same thread tends to get the same items in the
+  // solver's successive loops over the objects, whose matrices then stay in its core's cache.
   struct Job {
     const std::function<void(int)>* task = nullptr;
-    int n = 0;
-    std::atomic<int> next{0}, done{0};
+    int n = 0, segments = 1;
+    std::unique_ptr<std::atomic<int>[]> next;  // per segment: items claimed
+    std::atomic<int> done{0};
     std::mutex error_mutex;
     std::exception_ptr error;
-    void work();  // claims and runs items until none is left
+    Job(const std::function<void(int)>* task, int n, int segments);
+    void work(int thread);  // claims and runs items until none is left
   };
-  void workerLoop();
+  void workerLoop(int thread);
 
   std::vector<std::thread> workers_;
   std::mutex mutex_;

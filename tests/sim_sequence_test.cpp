@@ -67,6 +67,19 @@ TEST(SimSequence, SameSeedSameBytesOtherSeedOtherBytes) {
   for (const fs::path& d : {a, b, c}) fs::remove_all(d);
 }
 
+// Writing a shorter sequence over a longer one leaves exactly the new one (no stale scans).
+TEST(SimSequence, RewritingAShorterSequenceLeavesNoStaleScans) {
+  const sim::Scenario sc = scenario("intersection", 5);
+  const fs::path dir = tempDir("rewrite");
+  sim::writeSequence(sc, 5, 7, dir.string(), "0000", {2, false});
+  sim::writeSequence(sc, 3, 7, dir.string(), "0000", {2, false});
+  int scans = 0;
+  for (const auto& e : fs::directory_iterator(dir / "training" / "velodyne" / "0000")) scans += e.is_regular_file();
+  EXPECT_EQ(scans, 3);
+  EXPECT_EQ(kitti::SequenceReader(dir.string(), "0000").size(), 3);
+  fs::remove_all(dir);
+}
+
 TEST(SimSequence, ReaderGetsBackTheGeneratedGroundTruth) {
   const int frames = 6;
   const sim::Scenario sc = scenario("urban-static", frames);

@@ -22,6 +22,9 @@ SequenceStats writeSequence(const Scenario& scenario_in, int frames, uint64_t se
 
   const fs::path root(out_dir), training = root / "training";
   const fs::path velodyne = training / "velodyne" / sequence;
+  // The sequence is written anew: scans left from an earlier, longer run into the same folder
+  // would outnumber the new poses (the player then rejects the sequence).
+  fs::remove_all(velodyne);
   for (const fs::path& dir : {velodyne, training / "label_02", training / "calib", training / "oxts",
                               training / "poses", root / "detections" / "sim"})
     fs::create_directories(dir);

@@ -41,32 +41,30 @@ std::string Supervisor::describe(int code) {
   return "exited with code " + std::to_string(code);
 }
 
-std::optional<Supervisor::Exit> Supervisor::reap() {
-  for (Child& c : children_) {
-    if (c.done) continue;
-    int status = 0;
-    if (waitpid(c.pid, &status, WNOHANG) == c.pid) {
-      c.done = true;
-      c.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      return Exit{c.name, c.code, describe(c.code)};
-    }
-  }
-  return std::nullopt;
-}
-
-bool Supervisor::running(const std::string& name) {
-  Child& c = find(name);
-  if (c.done) return false;
+bool Supervisor::poll(Child& c) {
+  if (c.done) return true;
   int status = 0;
   if (waitpid(c.pid, &status, WNOHANG) == c.pid) {
     c.done = true;
     c.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   }
-  return !c.done;
+  return c.done;
 }
+
+std::optional<Supervisor::Exit> Supervisor::reap() {
+  for (Child& c : children_) {
+    if (c.reported || !poll(c)) continue;
+    c.reported = true;
+    return Exit{c.name, c.code, describe(c.code)};
+  }
+  return std::nullopt;
+}
+
+bool Supervisor::running(const std::string& name) { return !poll(find(name)); }
 
 int Supervisor::stop(const std::string& name, double grace_s) {
   Child& c = find(name);
+  c.reported = true;  // stopped on purpose: the caller gets the code
   if (!running(name)) return c.code;
   kill(c.pid, SIGINT);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(grace_s);

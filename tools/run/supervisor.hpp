@@ -18,8 +18,9 @@ class Supervisor {
   // Starts argv[0] with argv; output to log_path. Throws std::runtime_error when fork fails.
   void start(const std::string& name, const std::vector<std::string>& argv, const std::string& log_path);
 
-  // A child that has exited since the last call: its name and a description ("exited with
-  // code 3", "killed by signal 9"). Children stopped by stop() are not reported.
+  // A child that has exited and was not reported yet (running() may have noticed the exit
+  // first): its name and a description ("exited with code 3", "killed by signal 9"). Children
+  // stopped by stop() are not reported.
   struct Exit {
     std::string name;
     int code = 0;  // exit code, or 128 + signal
@@ -41,9 +42,12 @@ class Supervisor {
   struct Child {
     std::string name, log;
     pid_t pid = -1;
-    bool done = false;
+    bool done = false;      // exited (or stopped)
+    bool reported = false;  // by reap(), or stopped on purpose
     int code = 0;
   };
+  // Notes the exit of c if it has exited; true when it has.
+  static bool poll(Child& c);
   Child& find(const std::string& name);
   const Child& find(const std::string& name) const;
   static std::string describe(int code);

@@ -1,0 +1,53 @@
+// dlslot-run's Supervisor: a child's exit is reported once, with its code, however it was
+// first noticed (a failing player used to vanish when running() saw its exit before reap()).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+#include "supervisor.hpp"
+
+using namespace dlslot::run;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string logPath(const std::string& name) {
+  return (fs::temp_directory_path() / ("dlslot_supervisor_" + name + "_" + std::to_string(::getpid()) + ".log"))
+      .string();
+}
+
+void waitUntilExited(Supervisor& sup, const std::string& name) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (sup.running(name) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+}
+
+}  // namespace
+
+TEST(RunSupervisor, ExitNoticedByRunningIsStillReportedOnceWithItsCode) {
+  Supervisor sup;
+  sup.start("failing", {"/bin/sh", "-c", "echo bad input: frame 7 >&2; exit 3"}, logPath("failing"));
+  waitUntilExited(sup, "failing");
+  ASSERT_FALSE(sup.running("failing"));
+  const auto exit = sup.reap();
+  ASSERT_TRUE(exit);
+  EXPECT_EQ(exit->name, "failing");
+  EXPECT_EQ(exit->code, 3);
+  EXPECT_EQ(exit->how, "exited with code 3");
+  EXPECT_NE(sup.tail("failing").find("bad input: frame 7"), std::string::npos);
+  EXPECT_FALSE(sup.reap());  // once
+  fs::remove(logPath("failing"));
+}
+
+TEST(RunSupervisor, StoppedChildIsNotReported) {
+  Supervisor sup;
+  sup.start("sleeper", {"/bin/sleep", "30"}, logPath("sleeper"));
+  EXPECT_TRUE(sup.running("sleeper"));
+  EXPECT_EQ(sup.stop("sleeper", 5.0), 128 + SIGINT);
+  EXPECT_FALSE(sup.running("sleeper"));
+  EXPECT_FALSE(sup.reap());
+  fs::remove(logPath("sleeper"));
+}

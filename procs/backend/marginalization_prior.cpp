@@ -4,7 +4,7 @@
 
 namespace dlslot::backend {
 
-MarginalizationPrior::MarginalizationPrior(std::vector<Vector7> x_lin, RowMatrix J, Eigen::VectorXd r0,
+MarginalizationPrior::MarginalizationPrior(std::vector<Vector7> x_lin, dense::RowMatrix J, Eigen::VectorXd r0,
                                            Eigen::MatrixXd H0, Eigen::VectorXd g0)
     : x_lin_(std::move(x_lin)), J_(std::move(J)), r0_(std::move(r0)), JtJ_(std::move(H0)), Jtr0_(std::move(g0)) {
   set_num_residuals(static_cast<int>(r0_.size()));

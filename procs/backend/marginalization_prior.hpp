@@ -10,6 +10,7 @@
 
 #include <vector>
 
+#include "backend/dense_kernels.hpp"
 #include "backend/se3.hpp"
 
 namespace dlslot::backend {
@@ -20,8 +21,7 @@ class MarginalizationPrior final : public ceres::CostFunction {
   // and g0 = J^T r0 when the caller has them (the Marginalizer does), else computed.
   // (J is kept row-major: the Marginalizer's Cholesky factor L is J^T column-major, the same
   // storage.)
-  using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  MarginalizationPrior(std::vector<Vector7> x_lin, RowMatrix J, Eigen::VectorXd r0,
+  MarginalizationPrior(std::vector<Vector7> x_lin, dense::RowMatrix J, Eigen::VectorXd r0,
                        Eigen::MatrixXd H0 = Eigen::MatrixXd(), Eigen::VectorXd g0 = Eigen::VectorXd());
   // A prior on a single pose (e.g. the first ego pose, which fixes the gauge): r = S (x [-] x0).
   static MarginalizationPrior* CreatePosePrior(const Pose& x0, const Matrix6& sqrt_info);
@@ -48,7 +48,7 @@ class MarginalizationPrior final : public ceres::CostFunction {
 
  private:
   std::vector<Vector7> x_lin_;
-  RowMatrix J_;
+  dense::RowMatrix J_;
   Eigen::VectorXd r0_;
   Eigen::MatrixXd JtJ_;
   Eigen::VectorXd Jtr0_;

@@ -77,9 +77,9 @@ void schurComplement(Eigen::MatrixXd& H_mm, Eigen::MatrixXd& H_mr, Eigen::Matrix
 // H = J^T J and g = J^T r  ->  (J, r); J is upper triangular when H is definite (returns
 // true), else the eigen-decomposition without the null space (returns false). The Cholesky
 // factor L is formed in J's own storage: row-major J = L^T is column-major L.
-bool factorize(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, MarginalizationPrior::RowMatrix& J,
+bool factorize(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, dense::RowMatrix& J,
                Eigen::VectorXd& r) {
-  J = Eigen::Map<const MarginalizationPrior::RowMatrix>(H.data(), H.rows(), H.cols());  // H^T = H, a plain copy
+  J = Eigen::Map<const dense::RowMatrix>(H.data(), H.rows(), H.cols());  // H^T = H, a plain copy
   Eigen::Map<Eigen::MatrixXd> L(J.data(), J.rows(), J.cols());
   if (dense::cholesky(L)) {
     L.triangularView<Eigen::StrictlyUpper>().setZero();
@@ -198,7 +198,7 @@ std::optional<Factor> Marginalizer::marginalize(const std::vector<const Factor*>
     stats_.kept_dim = 6 * static_cast<int>(kept.size());
   }
 
-  MarginalizationPrior::RowMatrix J_star;
+  dense::RowMatrix J_star;
   Eigen::VectorXd r_star;
   if (!factorize(H_star, g_star, J_star, r_star)) {
     H_star.resize(0, 0);  // recomputed from J* (the null space was left out)

@@ -58,6 +58,8 @@ slot_state_t toMsg(const BackendOutput& out, const std::string& mode) {
     t.age = e.age;
     t.num_observations = e.num_observations;
     t.last_seen_frame = e.last_seen_frame;
+    t.status = e.status;
+    t.confidence = e.confidence;
     m.tracks.push_back(t);
   }
   m.num_tracks = static_cast<int32_t>(m.tracks.size());

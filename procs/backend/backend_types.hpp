@@ -46,6 +46,8 @@ struct TrackEstimate {
   int age = 0;               // frames since first seen
   int num_observations = 0;  // observations in the window
   int last_seen_frame = -1;
+  int8_t status = 1;         // track_t::STATUS_* (the tracker's lifecycle)
+  double confidence = 1.0;   // [0, 1], the tracker's lifecycle confidence
 };
 
 struct SolveStats {

@@ -108,6 +108,8 @@ associations_t toMsg(const JoinedFrame& joined, const EgoPose& ego, const FrameA
     for (int k = 0; k < 3; ++k) out.predicted[k] = p[k];
     out.is_dynamic = a.is_dynamic;
     out.displacement = a.displacement;
+    out.status = a.status;
+    out.confidence = a.confidence;
     m.associations.push_back(out);
   }
   m.num_associations = static_cast<int32_t>(m.associations.size());

@@ -54,6 +54,8 @@ struct Association {
   std::optional<Eigen::Vector3d> predicted;  // the trajectory's predicted position at this frame
   bool is_dynamic = false;
   double displacement = 0.0;
+  int8_t status = 1;          // association_t::STATUS_* of the trajectory after this detection
+  double confidence = 1.0;    // [0, 1], the trajectory's confidence after this detection
 };
 
 struct FrameAssociations {

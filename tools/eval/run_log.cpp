@@ -41,6 +41,7 @@ RunLog::Tracks tracksOf(const slot_state_t& msg, int track_max_unseen) {
     world.size = Eigen::Vector3d(t.size[0], t.size[1], t.size[2]);
     world.type = t.type;
     world.id = t.id;
+    world.score = t.confidence;  // the lifecycle's confidence ranks tracks for sAMOTA
     Object o;
     o.box = world.transformed(lidar_world);
     o.velocity = (lidar_world.linear() * Eigen::Vector3d(t.velocity[0], t.velocity[1], t.velocity[2])).head<2>();

@@ -252,6 +252,10 @@ void writeTrackingLabels(const std::string& path, const std::vector<LabelRow>& r
 
 // ---------------- results rows: the box in the image ----------------
 
+double observationAngle(const CameraBox& box) {
+  return wrapAngle(box.rotation_y - std::atan2(box.bottom_center.x(), box.bottom_center.z()));
+}
+
 std::optional<ImageBox> projectToImage(const CameraBox& box, const Calib& calib, const ImageSize& image) {
   const Calib::Projection& P2 = calib.P[2];
   if (P2.isZero()) throw std::invalid_argument("the calibration has no P2: boxes cannot be projected into image_02");
@@ -292,7 +296,7 @@ std::optional<ImageBox> projectToImage(const CameraBox& box, const Calib& calib,
   out.bbox2d << std::clamp(lo.x(), 0.0, xmax), std::clamp(lo.y(), 0.0, ymax), std::clamp(hi.x(), 0.0, xmax),
       std::clamp(hi.y(), 0.0, ymax);
   if (!(out.bbox2d[2] > out.bbox2d[0] && out.bbox2d[3] > out.bbox2d[1])) return std::nullopt;  // outside the image
-  out.alpha = wrapAngle(box.rotation_y - std::atan2(box.bottom_center.x(), box.bottom_center.z()));
+  out.alpha = observationAngle(box);
   return out;
 }
 

@@ -66,8 +66,10 @@ struct ImageSize {
 struct ImageBox {
   Eigen::Vector4d bbox2d = Eigen::Vector4d::Zero();     // left top right bottom, clipped to [0, w-1] x [0, h-1]
   Eigen::Vector4d unclipped = Eigen::Vector4d::Zero();  // the same before clipping to the image
-  double alpha = 0;  // observation angle, KITTI's: rotation_y - atan2(x, z) of the box position, in (-pi, pi]
+  double alpha = 0;  // observationAngle()
 };
+// KITTI's alpha: rotation_y - atan2(x, z) of the box position, wrapped to (-pi, pi].
+double observationAngle(const CameraBox& box);
 // The 8 corners projected with P2 (the edges cut at a near plane 0.1 m in front of the camera, so
 // a box partly behind it gets the image of its visible part). nullopt when the box is not in the
 // image: all of it behind the camera, or its projection entirely outside. Throws

@@ -311,6 +311,19 @@ TEST_F(EvalLog, ExportedFilesEvaluateLikeTheLog) {
   EXPECT_NEAR((tracks[7].boxes[0].center - expected.center).norm(), 0.0, 1e-5);
   EXPECT_NEAR(wrapAngle(tracks[7].boxes[0].yaw - expected.yaw), 0.0, 1e-5);
 
+  // Only boxes in the camera image are written: the pedestrian the ego has passed is left out.
+  int in_image = 0;
+  for (int t = 0; t < kFrames; ++t)
+    for (const Box& b : worldObjects(t))
+      in_image += kitti::resultRow(t, b.transformed(truePose(t).inverse()), testCalib()).has_value();
+  ASSERT_GT(in_image, 0);
+  ASSERT_LT(in_image, 2 * kFrames);
+  EXPECT_NE(r.err.find("tracks_kitti.txt: " + std::to_string(in_image) + " rows; " + std::to_string(2 * kFrames - in_image) +
+                       " track boxes outside the camera image left out"),
+            std::string::npos)
+      << r.err;
+  const std::string log_json = json;
+
   // The exported files evaluated as result files.
   r = eval("--traj " + path("export/trajectory_slot_kitti_cam.txt") + " --traj-format kitti_cam --tracks " +
            path("export/tracks_kitti.txt") + kitti + " --out " + path("files"));
@@ -318,8 +331,20 @@ TEST_F(EvalLog, ExportedFilesEvaluateLikeTheLog) {
   json = slurp(dir_ / "files" / "metrics.json");
   EXPECT_NE(json.find("\"ego.source\": \"result\""), std::string::npos) << json;
   EXPECT_NEAR(*value(json, "ego.ate_rmse_m"), 0.0, 1e-6);
-  EXPECT_DOUBLE_EQ(*value(json, "tracking.mota"), 1.0);
-  EXPECT_NEAR(*value(json, "tracking.hota"), 1.0, 1e-6);
+  // Bird's-eye view (360 deg): the labels outside the image are missed, nothing else.
+  EXPECT_DOUBLE_EQ(*value(json, "tracking.fn"), 2 * kFrames - in_image);
+  EXPECT_DOUBLE_EQ(*value(json, "tracking.fp"), 0);
+  EXPECT_DOUBLE_EQ(*value(json, "tracking.idsw"), 0);
+  // The KITTI protocol scores the log's tracks (projected, outside the image not scored) and the
+  // exported file alike.
+  for (const char* cls : {"car", "pedestrian"})
+    for (const char* key : {"mota", "motp", "samota", "amota", "idsw", "frag", "tp", "fp", "fn", "labels", "hota"}) {
+      const std::string k = std::string("tracking.") + cls + "." + key;
+      const std::optional<double> a = value(log_json, k), b = value(json, k);
+      ASSERT_EQ(a.has_value(), b.has_value()) << k;
+      if (a) EXPECT_NEAR(*a, *b, 1e-4) << k;  // the file holds 6 decimals
+    }
+  EXPECT_DOUBLE_EQ(*value(json, "tracking.car.tp") + *value(json, "tracking.pedestrian.tp"), in_image);
   // Track velocities come from the tracks' positions and the system's poses: exact here.
   EXPECT_NEAR(*value(json, "tracking.velocity_rmse_mps"), 0.0, 1e-4);
   EXPECT_EQ(json.find("timing_ms."), std::string::npos);  // result files carry no timing

@@ -1,12 +1,14 @@
 #include "dlslot/kitti.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 
 #include "dlslot/input_error.hpp"
 
@@ -246,6 +248,74 @@ void writeTrackingLabels(const std::string& path, const std::vector<LabelRow>& r
     std::fprintf(f, "\n");
   }
   std::fclose(f);
+}
+
+// ---------------- results rows: the box in the image ----------------
+
+double observationAngle(const CameraBox& box) {
+  return wrapAngle(box.rotation_y - std::atan2(box.bottom_center.x(), box.bottom_center.z()));
+}
+
+std::optional<ImageBox> projectToImage(const CameraBox& box, const Calib& calib, const ImageSize& image) {
+  const Calib::Projection& P2 = calib.P[2];
+  if (P2.isZero()) throw std::invalid_argument("the calibration has no P2: boxes cannot be projected into image_02");
+  // Corners as the devkit builds them: length along x, width along z, height up (-y) from the
+  // bottom centre, rotated by rotation_y about the camera's y axis.
+  const double c = std::cos(box.rotation_y), s = std::sin(box.rotation_y);
+  Eigen::Matrix3d Ry;
+  Ry << c, 0, s, 0, 1, 0, -s, 0, c;
+  std::array<Eigen::Vector3d, 8> corners;
+  for (int i = 0; i < 8; ++i)
+    corners[i] = box.bottom_center + Ry * Eigen::Vector3d((i & 1 ? 0.5 : -0.5) * box.l, i & 2 ? -box.h : 0.0,
+                                                          (i & 4 ? 0.5 : -0.5) * box.w);
+  // Depth along camera 2's axis is the third row of P2; cut every edge at the near plane.
+  constexpr double kNear = 0.1;
+  const auto depth = [&](const Eigen::Vector3d& p) { return P2.row(2).dot(p.homogeneous()); };
+  std::vector<Eigen::Vector3d> visible;
+  for (int i = 0; i < 8; ++i) {
+    const double di = depth(corners[i]);
+    if (di >= kNear) visible.push_back(corners[i]);
+    for (int bit : {1, 2, 4}) {
+      const int j = i | bit;
+      if (j == i) continue;
+      const double dj = depth(corners[j]);
+      if ((di - kNear) * (dj - kNear) < 0) visible.push_back(corners[i] + (kNear - di) / (dj - di) * (corners[j] - corners[i]));
+    }
+  }
+  if (visible.empty()) return std::nullopt;
+  Eigen::Vector2d lo(INFINITY, INFINITY), hi(-INFINITY, -INFINITY);
+  for (const Eigen::Vector3d& p : visible) {
+    const Eigen::Vector3d uvw = P2 * p.homogeneous();
+    const Eigen::Vector2d uv = uvw.head<2>() / uvw.z();
+    lo = lo.cwiseMin(uv);
+    hi = hi.cwiseMax(uv);
+  }
+  ImageBox out;
+  out.unclipped << lo.x(), lo.y(), hi.x(), hi.y();
+  const double xmax = image.width - 1, ymax = image.height - 1;
+  out.bbox2d << std::clamp(lo.x(), 0.0, xmax), std::clamp(lo.y(), 0.0, ymax), std::clamp(hi.x(), 0.0, xmax),
+      std::clamp(hi.y(), 0.0, ymax);
+  if (!(out.bbox2d[2] > out.bbox2d[0] && out.bbox2d[3] > out.bbox2d[1])) return std::nullopt;  // outside the image
+  out.alpha = observationAngle(box);
+  return out;
+}
+
+std::optional<LabelRow> resultRow(LabelRow row, const Calib& calib, const ImageSize& image) {
+  const std::optional<ImageBox> ib = projectToImage(row.box, calib, image);
+  if (!ib) return std::nullopt;
+  row.bbox2d = ib->bbox2d;
+  row.alpha = ib->alpha;
+  return row;
+}
+
+std::optional<LabelRow> resultRow(int frame, const Box& box_lidar, const Calib& calib, const ImageSize& image) {
+  LabelRow row;
+  row.frame = frame;
+  row.track_id = box_lidar.id;
+  row.type = box_lidar.type;
+  row.box = lidarToCamera(box_lidar, calib);
+  row.score = box_lidar.score;
+  return resultRow(std::move(row), calib, image);
 }
 
 std::vector<LabelRow> readCsvDetections(const std::string& path) {

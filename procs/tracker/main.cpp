@@ -112,10 +112,10 @@ int runOffline(const OfflineOptions& o, TrackerConfig config) {
   const OfflineResult r = associateSequence(reader, poses, config.associator, config.output);
   kitti::writeTrackingLabels(o.tracks_out, r.tracks);
   std::printf("%d frames, %d detections: %d associated (%d confirmed), %d not tracked (type %d, score %d, duplicate %d); "
-              "%d trajectories; %zu rows written (%s); association %.3f ms mean, %.3f ms p95 a frame\n",
+              "%d trajectories; %zu rows written (%s, %d outside the camera image left out); association %.3f ms mean, %.3f ms p95 a frame\n",
               reader.size(), r.detections, r.associated, r.confirmed, r.skipped.total(), r.skipped.untracked_type,
               r.skipped.below_score, r.skipped.duplicate, r.trajectories, r.tracks.size(),
-              config.output == TrackOutput::All ? "all tracks" : "confirmed tracks", r.association_ms.mean(),
+              config.output == TrackOutput::All ? "all tracks" : "confirmed tracks", r.outside_image, r.association_ms.mean(),
               r.association_ms.percentile(95));
   return 0;
 }

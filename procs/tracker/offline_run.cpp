@@ -55,14 +55,20 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
       const bool confirmed = a.status == TrackStatus::Confirmed;
       out.confirmed += confirmed;
       if (output == TrackOutput::Confirmed && !confirmed) continue;
-      kitti::LabelRow row;
-      row.frame = frame.index;
-      row.track_id = a.track_id;
-      row.type = a.box_lidar.type;
-      row.alpha = -10;  // the devkit's "unknown": no image observation angle from a 3D detector
-      row.box = kitti::lidarToCamera(a.box_lidar, reader.calib());
-      row.score = a.confidence;
-      out.tracks.push_back(row);
+      Box box = a.box_lidar;
+      box.id = a.track_id;
+      box.score = a.confidence;
+      if (const auto row = kitti::resultRow(frame.index, box, reader.calib()))
+        out.tracks.push_back(*row);
+      else
+        ++out.outside_image;
+    }
+    for (const CoastingTrack& c : r.coasting) {
+      ++out.coasting;
+      if (const auto row = kitti::resultRow(frame.index, c.box_lidar, reader.calib()))
+        out.tracks.push_back(*row);
+      else
+        ++out.outside_image;
     }
   }
   out.trajectories = max_id + 1;

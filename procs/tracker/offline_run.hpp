@@ -18,6 +18,7 @@ struct OfflineResult {
   TimingStats association_ms;           // per frame
   int detections = 0, associated = 0, confirmed = 0, trajectories = 0;
   SkippedDetections skipped;            // detections not tracked (type, score, duplicate)
+  int coasting = 0;                     // rows of confirmed tracks predicted through a detector miss
   int outside_image = 0;                // rows not written: the box is not in the camera image
 };
 

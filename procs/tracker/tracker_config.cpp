@@ -24,6 +24,7 @@ ClassPolicy readPolicy(const std::string& name, ConfigSection s) {
   s.get("min_hits", p.min_hits);
   s.get("max_misses", p.max_misses);
   s.get("max_polynomial_degree", p.max_polynomial_degree);
+  s.get("output_coasting_frames", p.output_coasting_frames);
   s.finish();
   return p;
 }

@@ -245,6 +245,28 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
     a.status = tr.lifecycle.status();
     a.confidence = tr.lifecycle.confidence();
   }
+  // Confirmed trajectories the detector missed this frame, reported at their prediction for a
+  // few frames; the confidence already counts the frames missed before this one, and this miss.
+  const Pose lidar_world = X_t.inverse();
+  for (int u = 0; u < U; ++u) {
+    const Trajectory& tr = trajectories_[u];
+    const int missed = frame - tr.last_frame;
+    if (assignment[u] >= 0 || !tr.lifecycle.confirmed() ||
+        missed > config_.classes[tr.policy].output_coasting_frames)
+      continue;
+    CoastingTrack c;
+    c.track_id = tr.id;
+    c.missed_frames = missed;
+    c.box_world = tr.last_box;
+    c.box_world.center.head<2>() = predicted[u].head<2>();
+    c.box_world.id = tr.id;
+    c.box_lidar = c.box_world.transformed(lidar_world);
+    TrackLifecycle after = tr.lifecycle;
+    after.miss();
+    c.confidence = after.confidence();
+    c.box_world.score = c.box_lidar.score = c.confidence;
+    out.coasting.push_back(c);
+  }
   out.num_active_tracks = static_cast<int>(trajectories_.size());
   return out;
 }

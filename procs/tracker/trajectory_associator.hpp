@@ -69,6 +69,16 @@ struct Association {
   double confidence = 0.0;    // [0, 1], the trajectory's confidence after this detection
 };
 
+// A confirmed trajectory the detector missed at this frame, reported at its prediction
+// (ClassPolicy::output_coasting_frames).
+struct CoastingTrack {
+  int track_id = -1;
+  int missed_frames = 0;  // frames since its last detection, this one included
+  Box box_world;          // its last box moved to the predicted position
+  Box box_lidar;          // the same in this scan's lidar frame
+  double confidence = 0.0;
+};
+
 // Detections that were not associated, and why (nothing is dropped silently).
 struct SkippedDetections {
   int untracked_type = 0;  // no class policy names the type
@@ -80,6 +90,7 @@ struct SkippedDetections {
 struct FrameAssociations {
   std::vector<Association> associations;  // one per tracked detection, in detection order
   SkippedDetections skipped;              // the detections without an association
+  std::vector<CoastingTrack> coasting;    // confirmed trajectories reported through a miss
   int num_active_tracks = 0;              // trajectories alive after this frame
   int num_ended_tracks = 0;               // trajectories that ended at this frame
 };

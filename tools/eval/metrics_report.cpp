@@ -62,32 +62,6 @@ std::vector<std::pair<std::string, Opt>> trackingValues(const std::optional<Trac
           {"velocity_rmse_mps", t ? t->clear.velocity_rmse_mps : std::nullopt}};
 }
 
-// The KITTI protocol's keys of one class, tracking.<class>.<key>.
-std::vector<std::pair<std::string, Opt>> kittiValues(const KittiClassMetrics& k) {
-  const auto count = [](int v) { return Opt(static_cast<double>(v)); };
-  return {{"mota", k.all.mota},
-          {"motp", k.all.motp},
-          {"samota", k.sweep.samota},
-          {"amota", k.sweep.amota},
-          {"idsw", count(k.all.idsw)},
-          {"frag", count(k.all.frag)},
-          {"tp", count(k.all.tp)},
-          {"fp", count(k.all.fp)},
-          {"fn", count(k.all.fn)},
-          {"labels", count(k.all.labels)},
-          {"ignored_labels", count(k.all.ignored_labels)},
-          {"ignored_tracks", count(k.all.ignored_tracks)},
-          {"hota", k.hota ? Opt(k.hota->hota) : std::nullopt},
-          {"deta", k.hota ? Opt(k.hota->deta) : std::nullopt},
-          {"assa", k.hota ? Opt(k.hota->assa) : std::nullopt},
-          {"recall_points", count(k.sweep.recall_points_reached)},
-          {"best_mota", k.sweep.best.mota},
-          {"best_idsw", count(k.sweep.best.idsw)},
-          {"best_threshold", k.sweep.best_threshold},
-          {"samota_ab3dmot", k.sweep_ab3dmot.samota},
-          {"amota_ab3dmot", k.sweep_ab3dmot.amota},
-          {"best_mota_ab3dmot", k.sweep_ab3dmot.best.mota}};
-}
 
 // A table rendered as Markdown with padded columns, so it reads well in a terminal too.
 class Table {
@@ -184,6 +158,33 @@ void writeText(const std::string& path, const std::string& text) {
 }
 
 }  // namespace
+
+// The KITTI protocol's keys of one class, tracking.<class>.<key>.
+std::vector<std::pair<std::string, std::optional<double>>> kittiValues(const KittiClassMetrics& k) {
+  const auto count = [](int v) -> std::optional<double> { return std::optional<double>(static_cast<double>(v)); };
+  return {{"mota", k.all.mota},
+          {"motp", k.all.motp},
+          {"samota", k.sweep.samota},
+          {"amota", k.sweep.amota},
+          {"idsw", count(k.all.idsw)},
+          {"frag", count(k.all.frag)},
+          {"tp", count(k.all.tp)},
+          {"fp", count(k.all.fp)},
+          {"fn", count(k.all.fn)},
+          {"labels", count(k.all.labels)},
+          {"ignored_labels", count(k.all.ignored_labels)},
+          {"ignored_tracks", count(k.all.ignored_tracks)},
+          {"hota", k.hota ? std::optional<double>(k.hota->hota) : std::nullopt},
+          {"deta", k.hota ? std::optional<double>(k.hota->deta) : std::nullopt},
+          {"assa", k.hota ? std::optional<double>(k.hota->assa) : std::nullopt},
+          {"recall_points", count(k.sweep.recall_points_reached)},
+          {"best_mota", k.sweep.best.mota},
+          {"best_idsw", count(k.sweep.best.idsw)},
+          {"best_threshold", k.sweep.best_threshold},
+          {"samota_ab3dmot", k.sweep_ab3dmot.samota},
+          {"amota_ab3dmot", k.sweep_ab3dmot.amota},
+          {"best_mota_ab3dmot", k.sweep_ab3dmot.best.mota}};
+}
 
 std::string metricsJson(const Metrics& m) {
   std::vector<std::pair<std::string, std::string>> kv;

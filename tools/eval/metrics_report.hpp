@@ -19,6 +19,8 @@ namespace dlslot::eval {
 // recall_points best_mota best_idsw best_threshold samota_ab3dmot amota_ab3dmot best_mota_ab3dmot; timing_ms.<module>.mean and
 // .p95; frames.<channel>.
 std::string metricsJson(const Metrics& m);
+// The KITTI protocol's numbers of one class as (key, value) pairs, in metrics.json's order.
+std::vector<std::pair<std::string, std::optional<double>>> kittiValues(const KittiClassMetrics& k);
 void writeMetricsJson(const std::string& path, const Metrics& m);
 
 // report.md: tables of every metric, notes, and the plots (paths relative to the report).

@@ -43,6 +43,9 @@ struct ClassPolicy {
   int max_polynomial_degree = 3;
   int min_hits = 3;    // detections inside the window before a track is confirmed
   int max_misses = 5;  // frames in a row without a detection before a track ends
+  // A confirmed track missed by the detector is still reported, at its predicted position, for
+  // this many frames (<= max_misses): a detector blinks more often than an object vanishes.
+  int output_coasting_frames = 0;
 
   void validate() const;  // std::invalid_argument naming the bad field
 };

@@ -178,3 +178,28 @@ TEST(TrackerPolicy, PedestriansInACrowdKeepTheirIdentities) {
   EXPECT_LT(with_policy * 100, associations);
   EXPECT_GT(with_car_settings, 10 * std::max(1, with_policy));
 }
+
+TEST(TrackerPolicy, WeakDetectionsOnlyExtendConfirmedTracks) {
+  AssociatorConfig cfg;
+  cfg.classes[0].min_score = 3.0;
+  cfg.classes[0].min_score_to_extend = 0.0;
+  cfg.classes[0].min_hits = 2;
+  TrajectoryAssociator a(cfg);
+  // A weak box alone starts nothing (counted as below score); one under min_score_to_extend is not tracked.
+  FrameAssociations r = step(a, 0, {box(10, 0, "Car", 1.0), box(30, 0, "Car", -1.0)});
+  EXPECT_TRUE(r.associations.empty());
+  EXPECT_EQ(r.skipped.below_score, 2);
+  // A strong box starts a track; confirmed at its second strong box; then a weak box extends it.
+  step(a, 1, {box(20, 0, "Car", 5.0)});
+  step(a, 2, {box(20.5, 0, "Car", 5.0)});
+  r = step(a, 3, {box(21.0, 0, "Car", 1.0)});
+  ASSERT_EQ(r.associations.size(), 1u);
+  EXPECT_EQ(r.associations[0].track_id, 0);
+  EXPECT_EQ(r.associations[0].status, TrackStatus::Confirmed);
+  // A weak box near a tentative track does not join it.
+  step(a, 4, {box(21.5, 0, "Car", 5.0), box(-20, 0, "Car", 5.0)});
+  r = step(a, 5, {box(-20, 0.2, "Car", 1.0)});
+  EXPECT_TRUE(r.associations.empty());
+  cfg.classes[0].min_score_to_extend = 4.0;  // above min_score: refused
+  EXPECT_THROW(TrajectoryAssociator{cfg}, std::invalid_argument);
+}

@@ -37,6 +37,8 @@ void ClassPolicy::validate() const {
   auto fail = [&](const std::string& what) { throw std::invalid_argument(name + "." + what); };
   if (types.empty()) fail("types: expected at least one KITTI type");
   if (std::isnan(min_score)) fail("min_score: expected a number");
+  if (!(min_score_to_extend <= min_score))
+    fail("min_score_to_extend: expected <= min_score, got " + std::to_string(min_score_to_extend));
   auto positive = [&](double v, const char* key) {
     if (!(v > 0) || !std::isfinite(v)) fail(std::string(key) + ": expected > 0, got " + std::to_string(v));
   };

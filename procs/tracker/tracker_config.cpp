@@ -17,6 +17,7 @@ ClassPolicy readPolicy(const std::string& name, ConfigSection s) {
   p.name = name;
   s.get("types", p.types);
   s.get("min_score", p.min_score);
+  s.get("min_score_to_extend", p.min_score_to_extend);
   s.get("gate_across_m", p.gate_across_m);
   s.get("gate_along_m", p.gate_along_m);
   s.get("young_gate_m", p.young_gate_m);

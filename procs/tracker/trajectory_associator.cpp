@@ -99,7 +99,7 @@ std::vector<int> TrajectoryAssociator::trackedDetections(const std::vector<Box>&
     const ClassPolicy* policy = policyFor(config_.classes, detections[v].type);
     if (!policy) {
       ++skipped.untracked_type;
-    } else if (detections[v].score < policy->min_score) {
+    } else if (detections[v].score < policy->min_score_to_extend) {
       ++skipped.below_score;
     } else {
       candidates.push_back(v);
@@ -198,7 +198,11 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
     for (int v = 0; v < V; ++v) {
       const Box& o = out.associations[v].box_world;
       const double g = gateDistance(tr, predicted[u], initialized[u], time_s, o.center);
-      admissible(u, v) = g < 1.0 && policyFor(config_.classes, o.type) == &config_.classes[tr.policy];
+      const ClassPolicy& policy = config_.classes[tr.policy];
+      // A weak detection (under min_score) may only extend a confirmed track.
+      const bool weak = o.score < policy.min_score;
+      admissible(u, v) = g < 1.0 && policyFor(config_.classes, o.type) == &policy &&
+                         (!weak || tr.lifecycle.confirmed());
       cost(u, v) = -(1.0 - g * g + (initialized[u] ? kInitializedBonus : 0.0));
     }
   }
@@ -207,8 +211,14 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
   for (int u = 0; u < U; ++u)
     if (assignment[u] >= 0) trajectory_of[assignment[u]] = u;
 
+  std::vector<char> keep(V, 1);
   for (int v = 0; v < V; ++v) {
     Association& a = out.associations[v];
+    if (trajectory_of[v] < 0 && a.box_lidar.score < policyFor(config_.classes, a.box_lidar.type)->min_score) {
+      keep[v] = 0;  // a weak detection that extends no confirmed track starts none either
+      ++out.skipped.below_score;
+      continue;
+    }
     const TrajectoryPoint point{frame, time_s, a.box_world.center};
     const int policy = static_cast<int>(policyFor(config_.classes, a.box_world.type) - config_.classes.data());
     const double detection_confidence = detectionConfidence(a.box_lidar.score, config_.score_scale);
@@ -245,6 +255,11 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
     a.status = tr.lifecycle.status();
     a.confidence = tr.lifecycle.confidence();
   }
+  std::vector<Association> kept;
+  for (int v = 0; v < V; ++v)
+    if (keep[v]) kept.push_back(std::move(out.associations[v]));
+  out.associations = std::move(kept);
+
   // Confirmed trajectories the detector missed this frame, reported at their prediction for a
   // few frames; the confidence already counts the frames missed before this one, and this miss.
   const Pose lidar_world = X_t.inverse();

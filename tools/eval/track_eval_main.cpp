@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <set>
 #include <sstream>
 
 #include "dlslot/kitti.hpp"
@@ -112,12 +113,15 @@ int run(int argc, char** argv) {
   const std::vector<std::string> sequences = sequences_arg.empty() ? sequencesIn(root) : splitList(sequences_arg);
   tracker::TrackerConfig sweep_cfg = cfg;
   sweep_cfg.output = tracker::TrackOutput::All;
-  for (ClassPolicy& p : sweep_cfg.associator.classes) p.min_score = -1e300;
+  for (ClassPolicy& p : sweep_cfg.associator.classes) p.min_score = p.min_score_to_extend = -1e300;
   fs::create_directories(fs::path(out) / "data");
   fs::create_directories(fs::path(out) / "data_all");
 
+  // Score the classes the detection files hold (a class without detections would only score its
+  // labels as misses).
   KittiProtocolOptions options;
   options.min_iou = min_iou;
+  std::set<std::string> detected;
   std::vector<KittiSequence> all, all_sweep;
   std::map<std::string, std::map<std::string, KittiClassMetrics>> per_sequence;
   std::vector<std::string> notes;
@@ -127,6 +131,9 @@ int run(int argc, char** argv) {
     const std::string& s = sequences[i];
     if (!quiet) progress.update(static_cast<int>(i), "sequence " + s);
     const kitti::SequenceReader reader(root, s, detections, -1e300, frame_period);
+    for (int f = 0; f < reader.size(); ++f)
+      for (const Box& b : reader.read(f).detections)
+        if (const ClassPolicy* p = policyFor(cfg.associator.classes, b.type)) detected.insert(p->name);
     if (reader.paths().labels.empty()) throw std::invalid_argument(root + ": sequence " + s + " has no label file");
     std::string pose_source;
     const std::vector<Pose> ego = tracker::egoPosesFor(reader, s, poses, &pose_source);
@@ -146,6 +153,7 @@ int run(int argc, char** argv) {
     const tracker::OfflineResult r_all = tracker::associateSequence(reader, ego, sweep_cfg.associator, sweep_cfg.output);
     kitti::writeTrackingLabels((fs::path(out) / "data_all" / (s + ".txt")).string(), r_all.tracks);
     KittiSequence seq_all{s, seq.labels, r_all.tracks, seq.frames};
+    options.classes.assign(detected.begin(), detected.end());
     per_sequence[s] = combine(evaluateKittiTracking({seq}, options), evaluateKittiTracking({seq_all}, options));
     all.push_back(std::move(seq));
     all_sweep.push_back(std::move(seq_all));

@@ -28,7 +28,11 @@ double detectionConfidence(double score, ScoreScale scale);
 struct ClassPolicy {
   std::string name;                // "car", "pedestrian", "cyclist"
   std::vector<std::string> types;  // KITTI types it covers
-  double min_score = -1e300;       // detections scoring below this (raw score) are not tracked
+  double min_score = -1e300;       // detections scoring below this (raw score) start no track
+  // Detections between this and min_score only extend confirmed tracks (a second, weaker tier, as
+  // in ByteTrack): a real object the detector is less sure of in one frame keeps its track, while
+  // the detector's many weak false positives never become tracks. Below it they are not tracked.
+  double min_score_to_extend = -1e300;
   // Association gate (eq. 6-7, made per class and anisotropic): a detection is admissible when
   // it lies inside an ellipse around the prediction whose axes are `gate_across_m` across the
   // predicted motion and `gate_along_m` along it; a trajectory predicting with its last position

@@ -95,8 +95,9 @@ Eigen::Vector3d TrajectoryAssociator::predict(const Trajectory& tr, double time_
 std::vector<int> TrajectoryAssociator::trackedDetections(const std::vector<Box>& detections,
                                                          SkippedDetections& skipped) const {
   std::vector<int> candidates;
+  std::vector<const ClassPolicy*> group(detections.size());
   for (int v = 0; v < static_cast<int>(detections.size()); ++v) {
-    const ClassPolicy* policy = policyFor(config_.classes, detections[v].type);
+    const ClassPolicy* policy = group[v] = policyFor(config_.classes, detections[v].type);
     if (!policy) {
       ++skipped.untracked_type;
     } else if (detections[v].score < policy->min_score_to_extend) {
@@ -114,10 +115,9 @@ std::vector<int> TrajectoryAssociator::trackedDetections(const std::vector<Box>&
   std::vector<int> kept;
   for (int v : candidates) {
     const Box& d = detections[v];
-    const ClassPolicy* group = policyFor(config_.classes, d.type);
     const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](int k) {
       const Box& o = detections[k];
-      if (policyFor(config_.classes, o.type) == group) return false;
+      if (group[k] == group[v]) return false;
       const Eigen::Vector2d local =
           Eigen::Rotation2Dd(-o.yaw) * (d.center.head<2>() - o.center.head<2>());
       return std::abs(local.x()) <= 0.5 * o.size.x() + config_.duplicate_margin_m &&
@@ -191,6 +191,8 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
   // position that may be a false positive (a matching cascade in one solve); the assignment
   // maximises the summed gain and leaves a pair unmatched when it gains more elsewhere.
   constexpr double kInitializedBonus = 0.5;
+  std::vector<const ClassPolicy*> policy_of(V);  // looked up once per detection, not per pair
+  for (int v = 0; v < V; ++v) policy_of[v] = policyFor(config_.classes, out.associations[v].box_world.type);
   Eigen::MatrixXd cost(U, V);
   Admissible admissible(U, V);
   for (int u = 0; u < U; ++u) {
@@ -201,7 +203,7 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
       const ClassPolicy& policy = config_.classes[tr.policy];
       // A weak detection (under min_score) may only extend a confirmed track.
       const bool weak = o.score < policy.min_score;
-      admissible(u, v) = g < 1.0 && policyFor(config_.classes, o.type) == &policy &&
+      admissible(u, v) = g < 1.0 && policy_of[v] == &policy &&
                          (!weak || tr.lifecycle.confirmed());
       cost(u, v) = -(1.0 - g * g + (initialized[u] ? kInitializedBonus : 0.0));
     }
@@ -214,13 +216,13 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
   std::vector<char> keep(V, 1);
   for (int v = 0; v < V; ++v) {
     Association& a = out.associations[v];
-    if (trajectory_of[v] < 0 && a.box_lidar.score < policyFor(config_.classes, a.box_lidar.type)->min_score) {
+    if (trajectory_of[v] < 0 && a.box_lidar.score < policy_of[v]->min_score) {
       keep[v] = 0;  // a weak detection that extends no confirmed track starts none either
       ++out.skipped.below_score;
       continue;
     }
     const TrajectoryPoint point{frame, time_s, a.box_world.center};
-    const int policy = static_cast<int>(policyFor(config_.classes, a.box_world.type) - config_.classes.data());
+    const int policy = static_cast<int>(policy_of[v] - config_.classes.data());
     const double detection_confidence = detectionConfidence(a.box_lidar.score, config_.score_scale);
     int u = trajectory_of[v];
     if (u >= 0) {

@@ -96,6 +96,7 @@ struct OfflineOptions {
   std::string kitti_root, sequence, poses, tracks_out, output;
   std::vector<std::string> detections;
   double min_detection_score = -1e9, frame_period_s = 0.1;
+  bool all_around = false;
 };
 
 // Associates a whole sequence from files and writes the tracks (no LCM).
@@ -109,13 +110,14 @@ int runOffline(const OfflineOptions& o, TrackerConfig config) {
   std::string pose_source;
   const std::vector<Pose> poses = egoPosesFor(reader, o.sequence, o.poses, &pose_source);
   std::fprintf(stderr, "%s\n", pose_source.c_str());
-  const OfflineResult r = associateSequence(reader, poses, config.associator, config.output);
+  const OfflineResult r = associateSequence(reader, poses, config.associator, config.output, o.all_around);
   kitti::writeTrackingLabels(o.tracks_out, r.tracks);
   std::printf("%d frames, %d detections: %d associated (%d confirmed), %d not tracked (type %d, score %d, duplicate %d); "
-              "%d trajectories; %zu rows written (%s, %d outside the camera image left out); association %.3f ms mean, %.3f ms p95 a frame\n",
+              "%d trajectories; %zu rows written (%s, %d outside the camera image%s); association %.3f ms mean, %.3f ms p95 a frame\n",
               reader.size(), r.detections, r.associated, r.confirmed, r.skipped.total(), r.skipped.untracked_type,
               r.skipped.below_score, r.skipped.duplicate, r.trajectories, r.tracks.size(),
-              config.output == TrackOutput::All ? "all tracks" : "confirmed tracks", r.outside_image, r.association_ms.mean(),
+              config.output == TrackOutput::All ? "all tracks" : "confirmed tracks", r.outside_image,
+              o.all_around ? ", written too" : " left out", r.association_ms.mean(),
               r.association_ms.percentile(95));
   return 0;
 }
@@ -137,6 +139,9 @@ int run(int argc, char** argv) {
   cl.option("--tracks-out", &off.tracks_out, "offline: output file, KITTI tracking result format");
   cl.option("--min-score", &off.min_detection_score, "offline: drop detections scoring below this (default -1e9)");
   cl.option("--output", &off.output, "offline: confirmed | all (default: tracker.output of the config)");
+  cl.flag("--all-around", &off.all_around,
+          "offline: also write tracks outside the camera image (2-D box -1), for labels all around the scan "
+          "(simulated sequences); not for the KITTI devkit");
   if (!cl.parse(argc, argv)) return 0;
 
   Channels channels;

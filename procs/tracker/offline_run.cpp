@@ -33,12 +33,29 @@ std::vector<Pose> egoPosesFor(const kitti::SequenceReader& reader, const std::st
 }
 
 OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::vector<Pose>& ego_poses,
-                                const AssociatorConfig& config, TrackOutput output) {
+                                const AssociatorConfig& config, TrackOutput output, bool all_around) {
   if (static_cast<int>(ego_poses.size()) < reader.size())
     throw std::invalid_argument("ego poses: " + std::to_string(ego_poses.size()) + " for " +
                                 std::to_string(reader.size()) + " frames");
   TrajectoryAssociator associator(config);
   OfflineResult out;
+  auto write = [&](int frame, const Box& box) {
+    if (auto row = kitti::resultRow(frame, box, reader.calib())) {
+      out.tracks.push_back(*row);
+      return;
+    }
+    ++out.outside_image;
+    if (!all_around) return;
+    kitti::LabelRow row;
+    row.frame = frame;
+    row.track_id = box.id;
+    row.type = box.type;
+    row.alpha = -10;
+    row.bbox2d = Eigen::Vector4d::Constant(-1);
+    row.box = kitti::lidarToCamera(box, reader.calib());
+    row.score = box.score;
+    out.tracks.push_back(row);
+  };
   int max_id = -1;
   for (int i = 0; i < reader.size(); ++i) {
     const Frame frame = reader.read(i);
@@ -58,17 +75,11 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
       Box box = a.box_lidar;
       box.id = a.track_id;
       box.score = a.confidence;
-      if (const auto row = kitti::resultRow(frame.index, box, reader.calib()))
-        out.tracks.push_back(*row);
-      else
-        ++out.outside_image;
+      write(frame.index, box);
     }
     for (const CoastingTrack& c : r.coasting) {
       ++out.coasting;
-      if (const auto row = kitti::resultRow(frame.index, c.box_lidar, reader.calib()))
-        out.tracks.push_back(*row);
-      else
-        ++out.outside_image;
+      write(frame.index, c.box_lidar);
     }
   }
   out.trajectories = max_id + 1;

@@ -25,8 +25,10 @@ struct OfflineResult {
 // Runs the associator over every frame of `reader`, with ego pose X_t = ego_poses[t]. Writes a
 // row for every association whose track is confirmed (TrackOutput::Confirmed) or for every
 // association (All); the score column is the track's confidence.
+// all_around: also write the rows outside the camera image (2-D box -1, alpha -10), for labels
+// that cover the whole scan (the simulator's); such a file is not for the KITTI devkit.
 OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::vector<Pose>& ego_poses,
-                                const AssociatorConfig& config, TrackOutput output);
+                                const AssociatorConfig& config, TrackOutput output, bool all_around = false);
 
 // The ego poses to track a sequence with: `poses` (a KITTI 3x4 lidar-pose file, or a directory
 // holding SSSS.txt), else the sequence's own ground truth, else identity (tracking in the sensor

@@ -497,9 +497,14 @@ SequencePaths locateSequence(const std::string& root, const std::string& sequenc
   fs::path tracking = fs::path(root) / "training";
   if (!fs::is_directory(tracking / "velodyne") && fs::is_directory(fs::path(root) / "velodyne")) tracking = root;
   const fs::path odometry = fs::path(root) / "sequences" / sequence;
-  if (fs::is_directory(tracking / "velodyne" / sequence)) {
+  const bool tracking_scans = fs::is_directory(tracking / "velodyne" / sequence);
+  // A tracking sequence without scans (labels, calib and detections: the usual MOT setting).
+  const bool tracking_no_scans = !tracking_scans && !fs::is_directory(odometry / "velodyne") &&
+                                 (fs::exists(tracking / "label_02" / (sequence + ".txt")) ||
+                                  fs::exists(tracking / "calib" / (sequence + ".txt")));
+  if (tracking_scans || tracking_no_scans) {
     p.layout = SequencePaths::Layout::Tracking;
-    p.velodyne_dir = (tracking / "velodyne" / sequence).string();
+    if (tracking_scans) p.velodyne_dir = (tracking / "velodyne" / sequence).string();
     p.calib = (tracking / "calib" / (sequence + ".txt")).string();
     p.labels = ifExists(tracking / "label_02" / (sequence + ".txt"));
     p.oxts = ifExists(tracking / "oxts" / (sequence + ".txt"));
@@ -517,6 +522,7 @@ SequencePaths locateSequence(const std::string& root, const std::string& sequenc
                                   " (KITTI tracking) or " + (odometry / "velodyne").string() + " (KITTI odometry)");
   }
   if (!fs::exists(p.calib)) throw InputError(p.calib, 0, "calibration file missing");
+  if (p.velodyne_dir.empty()) return p;  // no scans: SequenceReader counts frames from labels and detections
   int n = 0;
   for (const auto& e : fs::directory_iterator(p.velodyne_dir))
     if (e.path().extension() == ".bin") ++n;
@@ -547,6 +553,28 @@ SequenceReader::SequenceReader(const std::string& root, const std::string& seque
                                const std::vector<std::string>& detection_paths, double min_detection_score,
                                double frame_period_s)
     : paths_(locateSequence(root, sequence)), calib_(readCalib(paths_.calib)), frame_period_s_(frame_period_s) {
+  const std::vector<LabelRow> label_rows = paths_.labels.empty() ? std::vector<LabelRow>() : readTrackingLabels(paths_.labels);
+  std::vector<std::vector<LabelRow>> detection_rows;
+  for (std::string path : detection_paths) {
+    if (fs::is_directory(path)) path = (fs::path(path) / (sequence + ".txt")).string();
+    std::ifstream in = openText(path);
+    std::string first;
+    while (std::getline(in, first) && first.find_first_not_of(" \t\r") == std::string::npos) {
+    }
+    const bool csv = first.find(',') != std::string::npos;
+    detection_rows.push_back(csv ? readCsvDetections(path) : readTrackingLabels(path));
+  }
+  if (!hasScans()) {
+    // Without scans the sequence is as long as its labels and detections say.
+    int last = -1;
+    for (const LabelRow& r : label_rows) last = std::max(last, r.frame);
+    for (const auto& rows : detection_rows)
+      for (const LabelRow& r : rows) last = std::max(last, r.frame);
+    if (last < 0)
+      throw InputError(paths_.labels.empty() ? paths_.calib : paths_.labels, 0,
+                       "sequence " + sequence + " has no scans (no velodyne/), no labels and no detections: nothing to read");
+    paths_.num_frames = last + 1;
+  }
   const int n = paths_.num_frames;
   // Ground-truth ego poses: a poses file wins over oxts.
   if (!paths_.poses.empty()) {
@@ -564,21 +592,14 @@ SequenceReader::SequenceReader(const std::string& root, const std::string& seque
   if (!gt_poses_.empty() && static_cast<int>(gt_poses_.size()) < n)
     throw InputError(!paths_.poses.empty() ? paths_.poses : paths_.oxts, 0,
                      "has " + std::to_string(gt_poses_.size()) + " poses, expected one per scan (" + std::to_string(n) + ")");
-  if (!paths_.labels.empty()) labels_ = boxesByFrame(readTrackingLabels(paths_.labels), calib_, n);
+  if (!paths_.labels.empty()) labels_ = boxesByFrame(label_rows, calib_, n);
   if (!paths_.times.empty()) {
     times_ = readTimes(paths_.times);
     if (static_cast<int>(times_.size()) < n)
       throw InputError(paths_.times, 0, "has " + std::to_string(times_.size()) + " times, expected " + std::to_string(n));
   }
   if (!detection_paths.empty()) detections_.assign(n, {});
-  for (std::string path : detection_paths) {
-    if (fs::is_directory(path)) path = (fs::path(path) / (sequence + ".txt")).string();
-    std::ifstream in = openText(path);
-    std::string first;
-    while (std::getline(in, first) && first.find_first_not_of(" \t\r") == std::string::npos) {
-    }
-    const bool csv = first.find(',') != std::string::npos;
-    const auto rows = csv ? readCsvDetections(path) : readTrackingLabels(path);
+  for (const auto& rows : detection_rows) {
     const auto frames = boxesByFrame(rows, calib_, n, min_detection_score);
     for (int i = 0; i < n; ++i)
       detections_[i].boxes.insert(detections_[i].boxes.end(), frames[i].boxes.begin(), frames[i].boxes.end());
@@ -597,7 +618,7 @@ Frame SequenceReader::read(int index) const {
   f.utime = static_cast<int64_t>(std::llround(t * 1e6));
   char name[32];
   std::snprintf(name, sizeof name, "%06d.bin", index);
-  f.scan = readVelodyne((fs::path(paths_.velodyne_dir) / name).string());
+  if (hasScans()) f.scan = readVelodyne((fs::path(paths_.velodyne_dir) / name).string());
   if (!detections_.empty()) f.detections = detections_[index].boxes;
   if (!labels_.empty()) {
     f.labels = labels_[index].boxes;

@@ -138,8 +138,11 @@ void SlidingWindow::addObservations(const BackendInput& in) {
     track.size += (obs.box.size - track.size) / track.size_samples;
     track.last_seen = in.frame;
     track.dynamic_guess = obs.dynamic_guess;
+    track.confidence = obs.confidence;
     track.observations[in.frame] = Observation{alignedBox(track, X, obs.box), false};
-    if (!obs.initialized) continue;  // not in O_init yet: evidence only
+    // Not in O_init yet, or not confirmed by the tracker's lifecycle (a likely false positive):
+    // evidence only, never in the graph where it could pull the ego poses.
+    if (!obs.initialized || !obs.confirmed) continue;
     if (track.model == TrackModel::kNotInGraph) startTrack(track, in.frame);
     addTrackObservation(track, in.frame);
   }
@@ -300,6 +303,8 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
     e.dynamic = track.model == TrackModel::kDynamic;
     e.age = t - first_seen_.at(id);
     e.last_seen_frame = track.last_seen;
+    e.status = track.last_seen == t ? TrackStatus::Confirmed : TrackStatus::Coasting;
+    e.confidence = track.confidence;
     for (const auto& [f, obs] : track.observations) e.num_observations += obs.in_graph;
     const double* block = nullptr;
     if (!e.dynamic) {

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <map>
 
+#include "dlslot/input_error.hpp"
 #include "dlslot/kitti.hpp"
 #include "dlslot/progress.hpp"
 #include "dlslot/timing_stats.hpp"
@@ -27,6 +28,9 @@ const char* statusName(Status s) {
 int runOffline(const OfflineOptions& opts, const OdometryConfig& cfg) {
   kitti::SequenceReader reader(opts.root, opts.sequence, opts.detections, opts.min_detection_score,
                                opts.frame_period_s);
+  if (!reader.hasScans())
+    throw InputError(opts.root, 0, "sequence " + opts.sequence + " has no scans (expected training/velodyne/" +
+                                       opts.sequence + "/): odometry needs them");
   if (cfg.remove_detected_objects && opts.detections.empty())
     std::fprintf(stderr, "dlslot-odometry: mode aloam-filtered without --detections: nothing is removed\n");
   LidarOdometry odometry(cfg);

@@ -7,6 +7,7 @@
 #include "dlslot/convert.hpp"
 #include "dlslot/detections_t.hpp"
 #include "dlslot/ground_truth_t.hpp"
+#include "dlslot/input_error.hpp"
 #include "dlslot/kitti.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/point_cloud_t.hpp"
@@ -58,6 +59,10 @@ int run(int argc, char** argv) {
   if (sequence.empty()) throw std::invalid_argument("--sequence SSSS is required");
 
   kitti::SequenceReader reader(root, sequence, detections, cfg.min_detection_score, cfg.frame_period_s);
+  if (!reader.hasScans())
+    throw InputError(root, 0, "sequence " + sequence + " has no scans (expected training/velodyne/" + sequence +
+                                  "/): the player needs them; for tracking on detections alone use dlslot-tracker "
+                                  "--kitti or ./dlslot track-eval");
   const player::FrameRange range = player::resolveRange({start, end}, reader.size());
 
   Node node("player", node_opts.lcm_url, channels);

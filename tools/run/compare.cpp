@@ -49,6 +49,7 @@ int compare(int argc, char** argv) {
   cl.option("--lcm-url", &lcm_url, "LCM URL (default: $LCM_DEFAULT_URL)");
   if (!cl.parse(argc, argv)) return 0;
   if (root.empty() == scenario.empty()) throw std::invalid_argument("give either --kitti ROOT or --scenario NAME");
+  config = fs::absolute(findConfigFile(config)).string();
   if (out.empty()) out = "out/compare-" + (scenario.empty() ? sequence : fs::path(scenario).stem().string());
   fs::create_directories(out);
   const std::string bin = fs::read_symlink("/proc/self/exe").parent_path().string();

@@ -74,6 +74,7 @@ int runPipeline(int argc, char** argv) {
   cl.flag("--quiet", &quiet, "no progress line");
   if (!cl.parse(argc, argv)) return 0;
   if (out.empty()) throw std::invalid_argument("--out DIR is required");
+  config = fs::absolute(findConfigFile(config)).string();  // the children get the same file from any directory
   if (root.empty() == scenario.empty()) throw std::invalid_argument("give either --kitti ROOT or --scenario NAME");
   const ModeSettings ms = settingsFor(mode);
   const std::string bin = binDir();

@@ -117,7 +117,7 @@ std::vector<double> readTimes(const std::string& path);
 // odometry root (holding sequences/); which one is detected from what exists.
 struct SequencePaths {
   enum class Layout { Tracking, Odometry } layout = Layout::Tracking;
-  std::string velodyne_dir;
+  std::string velodyne_dir;     // "" for a tracking sequence without scans (labels, calib, detections only)
   std::string calib;            // calib file
   std::string labels;           // label_02 file ("" when absent)
   std::string oxts;             // "" when absent
@@ -125,7 +125,7 @@ struct SequencePaths {
   bool poses_are_lidar = false; // tracking layout training/poses/SSSS.txt (simulator): T_world_lidar;
                                 // odometry layout poses/XX.txt: T_world_cam0 (converted with the calib)
   std::string times;            // odometry times.txt ("" when absent)
-  int num_frames = 0;           // number of .bin files (must be 000000..N-1)
+  int num_frames = 0;           // number of .bin files (must be 000000..N-1); without scans, set by SequenceReader
 };
 SequencePaths locateSequence(const std::string& root, const std::string& sequence);
 
@@ -147,6 +147,9 @@ class SequenceReader {
                  const std::vector<std::string>& detection_paths = {}, double min_detection_score = -1e300,
                  double frame_period_s = 0.1);
   int size() const { return paths_.num_frames; }
+  // False for a tracking sequence with labels/detections but no velodyne/: its frames have empty
+  // scans and it has as many frames as its labels and detections reach.
+  bool hasScans() const { return !paths_.velodyne_dir.empty(); }
   const SequencePaths& paths() const { return paths_; }
   const Calib& calib() const { return calib_; }
   bool hasGroundTruthPoses() const { return !gt_poses_.empty(); }

@@ -350,6 +350,45 @@ TEST_F(EvalLog, ExportedFilesEvaluateLikeTheLog) {
   EXPECT_EQ(json.find("timing_ms."), std::string::npos);  // result files carry no timing
 }
 
+TEST_F(EvalLog, ResultsWithoutTwoDimensionalBoxesAreFlaggedAndFlatterTheTracker) {
+  writeKittiLayout(dir_ / "kitti");
+  const std::string kitti = " --kitti " + path("kitti") + " --sequence 0000";
+  // The labelled car, plus a false car track 10 m ahead of it, in every frame: once with the 2-D
+  // box of a projected 3-D box, once with 0 0 0 0 (as the tracker wrote before).
+  std::vector<kitti::LabelRow> good, flat;
+  for (int t = 0; t < kFrames; ++t) {
+    Box car = worldObjects(t)[0].transformed(truePose(t).inverse());
+    car.id = 1;
+    Box ghost = car;
+    ghost.center.x() += 10;
+    ghost.id = 2;
+    for (const Box& b : {car, ghost})
+      if (const auto row = kitti::resultRow(t, b, testCalib())) {
+        good.push_back(*row);
+        flat.push_back(*row);
+        flat.back().bbox2d.setZero();
+      }
+  }
+  ASSERT_GT(good.size(), 30u);
+  kitti::writeTrackingLabels(path("good.txt"), good);
+  kitti::writeTrackingLabels(path("flat.txt"), flat);
+  Result r = eval("--tracks " + path("good.txt") + kitti + " --out " + path("good"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("no 2-D box"), std::string::npos) << r.err;
+  const std::string json = slurp(dir_ / "good" / "metrics.json");
+  const int ghosts = static_cast<int>(good.size()) - static_cast<int>(*value(json, "tracking.car.tp"));
+  EXPECT_GT(ghosts, 0);
+  EXPECT_DOUBLE_EQ(*value(json, "tracking.car.fp"), ghosts);
+  r = eval("--tracks " + path("flat.txt") + kitti + " --out " + path("flat"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: KITTI protocol: " + std::to_string(flat.size()) + " of " +
+                       std::to_string(flat.size()) + " rows"),
+            std::string::npos)
+      << r.err;
+  // As the devkit counts it: no 2-D box, no false positive.
+  EXPECT_DOUBLE_EQ(*value(slurp(dir_ / "flat" / "metrics.json"), "tracking.car.fp"), 0);
+}
+
 TEST_F(EvalLog, ALogWithoutGroundTruthIsAnErrorUnlessAllowed) {
   writeRun(path("run.lcmlog"), false);
   Result r = eval("--log " + path("run.lcmlog"));

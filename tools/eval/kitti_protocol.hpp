@@ -47,7 +47,7 @@ struct KittiSequence {
   std::string name;                     // for messages, e.g. "0002"
   std::vector<kitti::LabelRow> labels;
   std::vector<kitti::LabelRow> tracks;
-  std::vector<int> frames;  // frames evaluated; empty: 0 .. the last frame any label or track row names
+  std::vector<int> frames;  // frames evaluated, ascending; empty: 0 .. the last frame any label or track row names
 };
 
 struct KittiProtocolOptions {

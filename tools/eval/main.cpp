@@ -175,10 +175,14 @@ KittiSequence kittiSequence(const Options& o, const DataSet& data, const std::ma
       flat += !(r.bbox2d[3] - r.bbox2d[1] > 0);
       outside += !kitti::projectToImage(r.box, *data.calib, image);
     }
-    if (flat > 0)
-      notes.push_back("KITTI protocol: " + std::to_string(flat) + " rows of " + o.tracks +
+    if (flat > 0) {
+      notes.push_back("KITTI protocol: " + std::to_string(flat) + " of " + std::to_string(seq.tracks.size()) +
+                      " rows of " + o.tracks +
                       " have no 2-D box (height <= 0): the devkit and AB3DMOT's script never count such a row as a "
-                      "false positive; write results with kitti::resultRow (the 3-D box projected with P2)");
+                      "false positive, so these numbers flatter the tracker; the 2-D box must be the 3-D box "
+                      "projected with P2 (kitti::resultRow)");
+      std::cerr << "dlslot-eval: warning: " << notes.back() << "\n";
+    }
     if (outside > 0)
       notes.push_back("KITTI protocol: " + std::to_string(outside) + " rows of " + o.tracks +
                       " have a 3-D box outside the camera image; scored by their 2-D box, as the devkit does");

@@ -1,5 +1,6 @@
 #include "dlslot/config.hpp"
 
+#include <filesystem>
 #include <fstream>
 
 namespace dlslot {
@@ -78,6 +79,8 @@ void ConfigSection::finish() const {
 }
 
 ConfigSection loadConfig(const std::string& file) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) throw ConfigError(file + ": is a directory, expected a config file");
   std::ifstream in(file);
   if (!in) throw ConfigError(file + ": cannot open config file");
   try {

@@ -8,6 +8,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
 #include <thread>
@@ -200,6 +201,17 @@ TEST(PipelineMalformedProcess, EveryNodeSurvivesCountsEveryCaseAndThePipelineFin
   // The launcher follows SLOT_STATE and PROCESS_STATUS.
   const int64_t launcher = sent("SLOT_STATE") + sent("PROCESS_STATUS");
   EXPECT_NE(text.find("launcher: refused " + std::to_string(launcher) + " messages"), std::string::npos) << text;
+  // Each process logged each (channel, reason) once, however often it came.
+  for (const std::string p : {"odometry", "tracker", "backend", "renderer", "player"}) {
+    std::ifstream in(out + "/run/logs/" + p + ".log");
+    std::map<std::string, int> lines;
+    for (std::string line; std::getline(in, line);) {
+      const auto at = line.find(": refused a message (");
+      if (at != std::string::npos) ++lines[line.substr(0, line.find(':', at + 21))];
+    }
+    EXPECT_FALSE(lines.empty()) << p;
+    for (const auto& [what, n] : lines) EXPECT_EQ(n, 1) << p << ": " << what;
+  }
   // The evaluator (run by dlslot-run) skipped every bad event of the log and said so.
   EXPECT_NE(text.find("events refused and skipped"), std::string::npos) << text;
   std::cout << "[ malformed ] " << pairs + 3 << " (process, channel) pairs live; cases per channel:";

@@ -1,7 +1,5 @@
 #include "dlslot/config.hpp"
 
-#include <unistd.h>
-
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -112,6 +110,7 @@ std::string findConfigFile(const std::string& given) {
 ConfigSection loadConfig(const std::string& given) {
   const std::string file = findConfigFile(given);
   std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) throw ConfigError(file + ": is a directory, expected a config file");
   std::cerr << "config: " << std::filesystem::absolute(file, ec).lexically_normal().string() << "\n";
   std::ifstream in(file);
   if (!in) throw ConfigError(file + ": cannot open config file");

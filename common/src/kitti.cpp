@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -18,6 +19,8 @@ namespace dlslot::kitti {
 namespace {
 
 constexpr double kEarthRadius = 6378137.0;  // the KITTI devkit's Mercator radius
+constexpr int kMaxFrame = 999999;      // six-digit file names (000000.bin)
+constexpr int kMaxTrackId = 999999;    // far beyond any sequence; keeps ids exact in an int
 
 std::vector<std::string> splitWs(const std::string& line) {
   std::istringstream is(line);
@@ -51,19 +54,38 @@ double number(const std::string& tok, const std::string& file, int line, const s
   }
   if (used != tok.size() || tok.empty())
     throw InputError(file, line, field + ": expected a number, got '" + tok + "'");
+  if (!std::isfinite(v)) throw InputError(file, line, field + ": expected a finite number, got '" + tok + "'");
   return v;
 }
 
-int integer(const std::string& tok, const std::string& file, int line, const std::string& field) {
+// An integer within [lo, hi] (the default: any int; a double beyond it must not wrap).
+int integer(const std::string& tok, const std::string& file, int line, const std::string& field,
+            double lo = std::numeric_limits<int>::min(), double hi = std::numeric_limits<int>::max()) {
   const double v = number(tok, file, line, field);
   if (v != std::floor(v)) throw InputError(file, line, field + ": expected an integer, got '" + tok + "'");
+  if (v < lo || v > hi)
+    throw InputError(file, line, field + ": expected an integer in " + std::to_string(static_cast<int64_t>(lo)) + ".." +
+                                     std::to_string(static_cast<int64_t>(hi)) + ", got '" + tok + "'");
   return static_cast<int>(v);
 }
 
+// A path that exists and is a regular file (a directory opens as a stream on Linux and reads as
+// garbage or fails with no file name).
+void requireFile(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw InputError(path, 0, "is a directory, expected a file");
+}
+
 std::ifstream openText(const std::string& path) {
+  requireFile(path);
   std::ifstream in(path);
   if (!in) throw InputError(path, 0, "cannot open file");
   return in;
+}
+
+// Box sizes in metres: finite (number() saw to that) and positive.
+void requirePositive(double v, const std::string& file, int line, const std::string& field) {
+  if (!(v > 0)) throw InputError(file, line, field + ": expected a size > 0 m, got " + std::to_string(v));
 }
 
 Pose rowsToPose(const std::vector<double>& v) {  // 12 numbers, 3x4 row-major
@@ -160,6 +182,7 @@ void writeCalib(const std::string& path, const Calib& calib) {
 // ---------------- velodyne ----------------
 
 PointCloud readVelodyne(const std::string& path) {
+  requireFile(path);
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw InputError(path, 0, "cannot open velodyne scan");
   const std::streamsize bytes = in.tellg();
@@ -218,9 +241,8 @@ std::vector<LabelRow> readTrackingLabels(const std::string& path) {
       throw InputError(path, n, "expected 17 fields (frame id type truncated occluded alpha x1 y1 x2 y2 h w l x y z "
                                 "rotation_y) or 18 (+ score), got " + std::to_string(t.size()));
     LabelRow r;
-    r.frame = integer(t[0], path, n, "frame");
-    if (r.frame < 0) throw InputError(path, n, "frame: expected >= 0, got " + t[0]);
-    r.track_id = integer(t[1], path, n, "track id");
+    r.frame = integer(t[0], path, n, "frame", 0, kMaxFrame);
+    r.track_id = integer(t[1], path, n, "track id", -1, kMaxTrackId);
     r.type = t[2];
     r.truncated = number(t[3], path, n, "truncated");
     r.occluded = integer(t[4], path, n, "occluded");
@@ -232,6 +254,11 @@ std::vector<LabelRow> readTrackingLabels(const std::string& path) {
     for (int i = 0; i < 3; ++i) r.box.bottom_center[i] = number(t[13 + i], path, n, "location");
     r.box.rotation_y = number(t[16], path, n, "rotation_y");
     if (t.size() == 18) r.score = number(t[17], path, n, "score");
+    if (r.type != "DontCare") {  // KITTI's DontCare rows carry -1 sizes: no 3D box
+      requirePositive(r.box.h, path, n, "h");
+      requirePositive(r.box.w, path, n, "w");
+      requirePositive(r.box.l, path, n, "l");
+    }
     rows.push_back(r);
   }
   return rows;
@@ -329,8 +356,7 @@ std::vector<LabelRow> readCsvDetections(const std::string& path) {
       throw InputError(path, n, "expected 15 comma-separated fields (frame,type,x1,y1,x2,y2,score,h,w,l,x,y,z,rot_y,"
                                 "alpha), got " + std::to_string(t.size()));
     LabelRow r;
-    r.frame = integer(t[0], path, n, "frame");
-    if (r.frame < 0) throw InputError(path, n, "frame: expected >= 0, got " + t[0]);
+    r.frame = integer(t[0], path, n, "frame", 0, kMaxFrame);
     const int type = integer(t[1], path, n, "type");
     static const std::map<int, std::string> kTypes = {{1, "Pedestrian"}, {2, "Car"}, {3, "Cyclist"}};
     auto it = kTypes.find(type);
@@ -344,6 +370,9 @@ std::vector<LabelRow> readCsvDetections(const std::string& path) {
     for (int i = 0; i < 3; ++i) r.box.bottom_center[i] = number(t[10 + i], path, n, "location");
     r.box.rotation_y = number(t[13], path, n, "rot_y");
     r.alpha = number(t[14], path, n, "alpha");
+    requirePositive(r.box.h, path, n, "h");
+    requirePositive(r.box.w, path, n, "w");
+    requirePositive(r.box.l, path, n, "l");
     rows.push_back(r);
   }
   return rows;
@@ -460,7 +489,12 @@ std::vector<Pose> readPoses(const std::string& path) {
       throw InputError(path, n, "expected 12 numbers (a 3x4 row-major pose), got " + std::to_string(t.size()));
     std::vector<double> v;
     for (const auto& s : t) v.push_back(number(s, path, n, "pose"));
-    poses.push_back(rowsToPose(v));
+    const Pose T = rowsToPose(v);
+    const double off = (T.linear().transpose() * T.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    if (off > 1e-3 || T.linear().determinant() < 0)
+      throw InputError(path, n, "pose: expected a rotation in the 3x3 block (R^T R = I, det 1), off by " +
+                                    std::to_string(off));
+    poses.push_back(T);
   }
   return poses;
 }

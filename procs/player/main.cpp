@@ -69,13 +69,20 @@ int run(int argc, char** argv) {
   installSignalHandlers();
   node.every(1.0, [&] { node.publishStatus(); });
 
-  // Lockstep: remember the newest frame seen on the followed channel, whatever its type.
-  int acked_frame = -1;
+  // Lockstep: remember the newest frame seen on the followed channel, whatever its type. Only a
+  // frame this player has already published can acknowledge one (a stray frame 10^9 must not
+  // release every frame after it).
+  int acked_frame = -1, published_frame = -1;
   if (!lockstep.empty())
     node.subscribeRaw(lockstep, [&](const lcm::ReceiveBuffer& rbuf) {
       const int f = frameOfEncoded(rbuf.data, rbuf.data_size);
-      if (f < 0) node.status().decodeError(lockstep);
-      acked_frame = std::max(acked_frame, f);
+      if (f < 0)
+        node.status().refused(lockstep, {"truncated", "too short to hold a frame number"});
+      else if (f > published_frame)
+        node.status().refused(lockstep, {"frame_range", "frame " + std::to_string(f) + " not played yet (newest " +
+                                                            std::to_string(published_frame) + ")"});
+      else
+        acked_frame = std::max(acked_frame, f);
     });
 
   node.spinUntil([] { return false; }, delay_s);
@@ -120,6 +127,7 @@ int run(int argc, char** argv) {
       gt.num_dontcare = static_cast<int32_t>(gt.dontcare.size());
       node.publish(channels.ground_truth, gt);
     }
+    published_frame = frame.index;
     node.status().frameDone(frame.index, std::chrono::duration<double, std::milli>(Node::Clock::now() - tic).count());
     ++played;
 

@@ -48,6 +48,9 @@ void report(const FrameSink& sink, const std::string& out, const std::string& su
             << s.time_mean_ms << " ms, p95 " << s.time_p95_ms << " ms)";
   if (!summary.empty()) std::cerr << ", summary " << summary;
   if (s.decode_errors) std::cerr << ", " << s.decode_errors << " undecodable messages";
+  int64_t refused = 0;
+  for (const auto& [what, n] : status.refusals()) refused += n;
+  if (refused) std::cerr << ", " << refused << " refused messages";
   std::cerr << "\n";
 }
 

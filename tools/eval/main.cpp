@@ -49,8 +49,7 @@ Channels readChannels(const std::string& config) {
   // The default config is optional (the built-in channel names are the shipped ones); a config
   // given explicitly must exist.
   if (config == Options().config && !fs::exists(config)) return channels;
-  ConfigSection root = loadConfig(config);
-  channels.read(root.section("channels"));
+  loadPipelineConfig(config, channels);  // every section known (a misspelt one is an error)
   return channels;
 }
 
@@ -275,6 +274,17 @@ int run(int argc, char** argv) {
     run.timing_ms = log->timing_ms;
     run.frame_counts = log->frame_counts;
     addProcessNotes(*log, run);
+    if (!log->refused.empty()) {
+      std::ostringstream n;
+      int64_t total = 0;
+      for (const auto& [what, count] : log->refused) {
+        n << (total ? ", " : "") << what << " " << count;
+        total += count;
+      }
+      const std::string note = "log: " + std::to_string(total) + " events refused and skipped (" + n.str() + ")";
+      std::cerr << "dlslot-eval: " << o.log << ": " << note << "\n";
+      run.notes.push_back(note);
+    }
   }
   // Data-set files win over what the log carried.
   if (data.poses) run.truth = data.poses;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "dlslot/hungarian.hpp"
@@ -132,25 +133,38 @@ std::vector<int> TrajectoryAssociator::trackedDetections(const std::vector<Box>&
   return kept;
 }
 
-double TrajectoryAssociator::gateDistance(const Trajectory& tr, const Eigen::Vector3d& predicted, bool initialized,
-                                          double time_s, const Eigen::Vector3d& p) const {
+TrajectoryAssociator::Gate TrajectoryAssociator::gateOf(const Trajectory& tr, const Eigen::Vector3d& predicted,
+                                                       bool initialized, double time_s) const {
   const ClassPolicy& policy = config_.classes[tr.policy];
   // The gates grow with the time the trajectory has gone unseen: its prediction spans that long.
   const double growth = policy.gate_growth_mps * std::max(0.0, time_s - tr.last_time_s);
-  const Eigen::Vector2d d = p.head<2>() - predicted.head<2>();
+  Gate g;
+  g.center = predicted.head<2>();
+  g.along_unit = Eigen::Vector2d::UnitX();
   if (!initialized || config_.predictor == Predictor::LastPosition) {
-    const double r = policy.young_gate_m + growth;
-    return d.norm() / r;
+    g.along = g.across = policy.young_gate_m + growth;
+    return g;
   }
   // The gate in the predicted motion's frame: along the motion the prediction is less certain
   // (speed changes) than across it (lane, pavement), so neighbours walking or driving side by
   // side are kept apart while an object that speeds up is still followed.
   const Eigen::Vector2d motion = predicted.head<2>() - tr.window.back().position.head<2>();
-  const double along_axis = policy.gate_along_m + growth, across_axis = policy.gate_across_m + growth;
-  if (motion.norm() < 1e-3) return d.norm() / std::min(along_axis, across_axis);
-  const Eigen::Vector2d u = motion.normalized();
-  const double along = d.dot(u), across = u.x() * d.y() - u.y() * d.x();
-  return std::hypot(along / along_axis, across / across_axis);
+  g.along = policy.gate_along_m + growth;
+  g.across = policy.gate_across_m + growth;
+  if (motion.norm() < 1e-3) {
+    g.along = g.across = std::min(g.along, g.across);  // no direction: the tighter circle
+  } else {
+    g.along_unit = motion.normalized();
+  }
+  return g;
+}
+
+double TrajectoryAssociator::Gate::distance(const Eigen::Vector2d& p) const {
+  const Eigen::Vector2d d = p - center;
+  const double outer = std::max(along, across);
+  if (d.squaredNorm() >= outer * outer) return std::numeric_limits<double>::infinity();  // most pairs: far apart
+  const double a = d.dot(along_unit), c = along_unit.x() * d.y() - along_unit.y() * d.x();
+  return std::hypot(a / along, c / across);
 }
 
 FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, const Pose& X_t,
@@ -197,15 +211,16 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
   Admissible admissible(U, V);
   for (int u = 0; u < U; ++u) {
     const Trajectory& tr = trajectories_[u];
+    const Gate gate = gateOf(tr, predicted[u], initialized[u], time_s);
     for (int v = 0; v < V; ++v) {
       const Box& o = out.associations[v].box_world;
-      const double g = gateDistance(tr, predicted[u], initialized[u], time_s, o.center);
+      const double g = gate.distance(o.center.head<2>());
       const ClassPolicy& policy = config_.classes[tr.policy];
       // A weak detection (under min_score) may only extend a confirmed track.
       const bool weak = o.score < policy.min_score;
       admissible(u, v) = g < 1.0 && policy_of[v] == &policy &&
                          (!weak || tr.lifecycle.confirmed());
-      cost(u, v) = -(1.0 - g * g + (initialized[u] ? kInitializedBonus : 0.0));
+      cost(u, v) = admissible(u, v) ? -(1.0 - g * g + (initialized[u] ? kInitializedBonus : 0.0)) : 0.0;
     }
   }
   const std::vector<int> assignment = solveGatedAssignment(cost, admissible, Objective::LeastCost);

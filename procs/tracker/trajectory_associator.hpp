@@ -115,9 +115,14 @@ class TrajectoryAssociator {
   int endAndSlide(int frame);
   // Which detections are tracked: policy, score threshold, duplicate suppression.
   std::vector<int> trackedDetections(const std::vector<Box>& detections, SkippedDetections& skipped) const;
-  // Eq. 6-7 per class: is the detection at `p` (world) inside trajectory u's gate, and how far (in gates)?
-  double gateDistance(const Trajectory& tr, const Eigen::Vector3d& predicted, bool initialized, double time_s,
-                      const Eigen::Vector3d& p) const;
+  // Eq. 6-7 per class: trajectory u's gate at this frame (see gateOf in the .cpp).
+  struct Gate {
+    Eigen::Vector2d center, along_unit;  // the prediction, the unit vector of the predicted motion
+    double along = 1, across = 1;        // semi-axes (equal for a circle)
+    // Distance of `p` in gates: < 1 inside.
+    double distance(const Eigen::Vector2d& p) const;
+  };
+  Gate gateOf(const Trajectory& tr, const Eigen::Vector3d& predicted, bool initialized, double time_s) const;
   // The position a trajectory predicts for time_s, and whether that prediction makes it initialized.
   Eigen::Vector3d predict(const Trajectory& tr, double time_s, bool* initialized) const;
 

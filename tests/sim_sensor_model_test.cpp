@@ -124,6 +124,7 @@ TEST(SimSensorModel, FiringPhaseChangesFromRevolutionToRevolution) {
 
 TEST(SimSensorModel, BeamResidualsHaveTheConfiguredSpreadAndKittisVerticalError) {
   sim::SensorSpec s;
+  s.vertical_angle_error_deg = 0;
   s.beam_elevation_error_deg = 0.05;
   s.beam_azimuth_error_deg = 0.08;
   s.beam_range_bias_m = 0.03;

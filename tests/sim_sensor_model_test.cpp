@@ -201,6 +201,20 @@ TEST(SimSensorModel, PorousSolidsStopRaysAtAnExponentialDepth) {
   }
   EXPECT_NEAR(hits / double(n), 1 - std::exp(-6.0 / 0.6), 1e-3);
   EXPECT_NEAR(depth / hits, 0.6, 0.01);
+  // The shipped street has porous crowns (spheres) and wire fences (thin boxes); switched off, none.
+  for (const bool on : {true, false}) {
+    sim::Scenario sc = scenario("urban-static", 1);
+    if (!on) sc.sensor.vegetation_mean_free_path_m = sc.sensor.fences = 0;
+    sim::Simulation sim(sc);
+    int crowns = 0, fences = 0;
+    for (const sim::Solid& solid : sim.world().grid->solids()) {
+      if (solid.mean_free_path <= 0) continue;
+      crowns += solid.kind == sim::SolidKind::Sphere;
+      fences += solid.kind == sim::SolidKind::Box && solid.half.y() < 0.05;
+    }
+    EXPECT_EQ(crowns > 10, on);
+    EXPECT_EQ(fences > 3, on);
+  }
   crown.mean_free_path = 0;  // opaque: the surface
   double s;
   ASSERT_TRUE(sim::intersectPorous(crown, o, d, 100, 0.9, s));

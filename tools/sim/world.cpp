@@ -121,8 +121,8 @@ class RoadsideBuilder {
         const Path::Sample at = road.centre.at(ws + 0.5 * open);
         const Eigen::Vector2d c = at.p + side * (rs.frontage_m + 0.15) * leftOf(at.heading);
         Solid wall = standing(c, at.heading, open, 0.3, rng_.uniform(1.2, 2.6), 0.3f);
-        // Some are wire fences that most rays pass (a draw of their own: the world is otherwise the
-        // same with fences on or off). Thickness t passes exp(-t / mean_free_path) of square-on rays.
+        // Some are wire fences that many rays pass (a draw of their own, so the roadside's other
+        // draws stay as they were). Thickness t passes exp(-t / mean_free_path) of square-on rays.
         if (sensor_.fence_pass > 0 && sensor_.fence_pass < 1 &&
             Rng(streamKey({fence_key_, walls_++})).chance(sensor_.fences)) {
           constexpr double kThick = 0.05;

@@ -36,7 +36,7 @@ Matrix6d solveCovariance(const Matrix6d& normal_matrix, const OdometryConfig& cf
 
 LidarOdometry::LidarOdometry(OdometryConfig cfg)
     : cfg_(std::move(cfg)),
-      map_(cfg_.scan_to_map.edge_voxel_m, cfg_.scan_to_map.plane_voxel_m, cfg_.scan_to_map.map_radius_m) {}
+      map_(cfg_.scan_to_map) {}
 
 void LidarOdometry::reset() {
   map_.clear();

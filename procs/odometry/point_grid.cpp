@@ -1,0 +1,94 @@
+#include "point_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dlslot::odometry {
+
+int64_t PointGrid::key(int64_t x, int64_t y, int64_t z) const {
+  const int64_t off = int64_t{1} << 20;  // 21 bits per axis
+  return ((x + off) << 42) | ((y + off) << 21) | (z + off);
+}
+
+int64_t PointGrid::cellOf(float v) const { return static_cast<int64_t>(std::floor(v / cell_)); }
+
+void PointGrid::build(const FeatureCloud& cloud) {
+  cells_.clear();
+  start_.clear();
+  const size_t n = cloud.size();
+  // Counting sort by cell: number the cells in order of first appearance, count, place.
+  std::vector<int> cell_of(n);
+  std::vector<int> count;
+  for (size_t i = 0; i < n; ++i) {
+    const auto& p = cloud[i];
+    const int64_t k = key(cellOf(p.x), cellOf(p.y), cellOf(p.z));
+    int c = cells_.find(k);
+    if (c == BlockIndex::kMissing) {
+      c = static_cast<int>(count.size());
+      cells_.set(k, c);
+      count.push_back(0);
+    }
+    ++count[c];
+    cell_of[i] = c;
+  }
+  start_.assign(count.size() + 1, 0);
+  for (size_t c = 0; c < count.size(); ++c) start_[c + 1] = start_[c] + count[c];
+  std::vector<int> next(start_.begin(), start_.end() - 1);
+  points_.resize(n);
+  original_.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const int j = next[cell_of[i]]++;
+    points_[j] = cloud[i].getVector3fMap();
+    original_[j] = static_cast<int>(i);
+  }
+}
+
+void PointGrid::visit(int64_t x, int64_t y, int64_t z, const Eigen::Vector3f& q, int k, float max_d2,
+                      std::vector<int>& idx, std::vector<float>& d2) const {
+  const int c = cells_.find(key(x, y, z));
+  if (c == BlockIndex::kMissing) return;
+  for (int j = start_[c]; j < start_[c + 1]; ++j) {
+    const float d = (points_[j] - q).squaredNorm();
+    const int n = static_cast<int>(d2.size());
+    if (d >= max_d2 || (n == k && d >= d2.back())) continue;
+    if (n < k) {
+      d2.push_back(d);
+      idx.push_back(original_[j]);
+    }
+    int i = static_cast<int>(d2.size()) - 1;
+    for (; i > 0 && d2[i - 1] > d; --i) {
+      d2[i] = d2[i - 1];
+      idx[i] = idx[i - 1];
+    }
+    d2[i] = d;
+    idx[i] = original_[j];
+  }
+}
+
+void PointGrid::nearest(const Eigen::Vector3f& q, int k, float max_d2, std::vector<int>& idx,
+                        std::vector<float>& d2) const {
+  idx.clear();
+  d2.clear();
+  if (points_.empty() || k <= 0) return;
+  const int64_t cx = cellOf(q.x()), cy = cellOf(q.y()), cz = cellOf(q.z());
+  // Room between q and the faces of its own cell, per axis (lower, upper).
+  const Eigen::Vector3d lo(q.x() - cx * cell_, q.y() - cy * cell_, q.z() - cz * cell_);
+  const Eigen::Vector3d hi = Eigen::Vector3d::Constant(cell_) - lo;
+  const double room = std::min(lo.minCoeff(), hi.minCoeff());
+  for (int64_t s = 0;; ++s) {
+    // Shell s: the cells at Chebyshev distance s from q's cell.
+    for (int64_t dz = -s; dz <= s; ++dz)
+      for (int64_t dy = -s; dy <= s; ++dy) {
+        const bool face = std::abs(dz) == s || std::abs(dy) == s;
+        for (int64_t dx = -s; dx <= s; dx += face ? 1 : 2 * std::max<int64_t>(s, 1))
+          visit(cx + dx, cy + dy, cz + dz, q, k, max_d2, idx, d2);
+      }
+    // Every point not yet visited lies at least this far from q.
+    const double reach = room + static_cast<double>(s) * cell_;
+    const double reach2 = reach * reach;
+    if (reach2 >= max_d2) return;
+    if (static_cast<int>(d2.size()) == k && d2.back() <= reach2) return;
+  }
+}
+
+}  // namespace dlslot::odometry

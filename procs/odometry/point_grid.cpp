@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace dlslot::odometry {
 
@@ -19,9 +20,14 @@ void PointGrid::build(const FeatureCloud& cloud) {
   // Counting sort by cell: number the cells in order of first appearance, count, place.
   std::vector<int> cell_of(n);
   std::vector<int> count;
+  lo_.setConstant(INT64_MAX);
+  hi_.setConstant(INT64_MIN);
   for (size_t i = 0; i < n; ++i) {
     const auto& p = cloud[i];
-    const int64_t k = key(cellOf(p.x), cellOf(p.y), cellOf(p.z));
+    const Eigen::Matrix<int64_t, 3, 1> v(cellOf(p.x), cellOf(p.y), cellOf(p.z));
+    lo_ = lo_.cwiseMin(v);
+    hi_ = hi_.cwiseMax(v);
+    const int64_t k = key(v.x(), v.y(), v.z());
     int c = cells_.find(k);
     if (c == BlockIndex::kMissing) {
       c = static_cast<int>(count.size());
@@ -76,13 +82,23 @@ void PointGrid::nearest(const Eigen::Vector3f& q, int k, float max_d2, std::vect
   const Eigen::Vector3d hi = Eigen::Vector3d::Constant(cell_) - lo;
   const double room = std::min(lo.minCoeff(), hi.minCoeff());
   for (int64_t s = 0;; ++s) {
-    // Shell s: the cells at Chebyshev distance s from q's cell.
-    for (int64_t dz = -s; dz <= s; ++dz)
-      for (int64_t dy = -s; dy <= s; ++dy) {
-        const bool face = std::abs(dz) == s || std::abs(dy) == s;
-        for (int64_t dx = -s; dx <= s; dx += face ? 1 : 2 * std::max<int64_t>(s, 1))
-          visit(cx + dx, cy + dy, cz + dz, q, k, max_d2, idx, d2);
+    // Shell s: the cells at Chebyshev distance s from q's cell, inside the bounding box.
+    const int64_t z0 = std::max(cz - s, lo_.z()), z1 = std::min(cz + s, hi_.z());
+    const int64_t y0 = std::max(cy - s, lo_.y()), y1 = std::min(cy + s, hi_.y());
+    const int64_t x0 = std::max(cx - s, lo_.x()), x1 = std::min(cx + s, hi_.x());
+    for (int64_t z = z0; z <= z1; ++z)
+      for (int64_t y = y0; y <= y1; ++y) {
+        if (std::abs(z - cz) == s || std::abs(y - cy) == s) {
+          for (int64_t x = x0; x <= x1; ++x) visit(x, y, z, q, k, max_d2, idx, d2);
+        } else {
+          if (cx - s >= lo_.x()) visit(cx - s, y, z, q, k, max_d2, idx, d2);
+          if (s > 0 && cx + s <= hi_.x()) visit(cx + s, y, z, q, k, max_d2, idx, d2);
+        }
       }
+    // The shell cube holds every cell: nothing is left.
+    if (cx - s <= lo_.x() && cy - s <= lo_.y() && cz - s <= lo_.z() && cx + s >= hi_.x() && cy + s >= hi_.y() &&
+        cz + s >= hi_.z())
+      return;
     // Every point not yet visited lies at least this far from q.
     const double reach = room + static_cast<double>(s) * cell_;
     const double reach2 = reach * reach;

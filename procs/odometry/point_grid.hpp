@@ -32,6 +32,7 @@ class PointGrid {
              std::vector<float>& d2) const;
 
   double cell_;
+  Eigen::Matrix<int64_t, 3, 1> lo_, hi_;  // the cells' bounding box: shells are clipped to it
   BlockIndex cells_;                    // cell key -> cell number
   std::vector<int> start_;              // cell c holds points_[start_[c], start_[c + 1])
   std::vector<Eigen::Vector3f> points_; // grouped by cell

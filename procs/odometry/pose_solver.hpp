@@ -55,6 +55,8 @@ void measureConstraint(const Matches& matches, double huber_delta, PoseSolution&
 struct Registration {
   PoseSolution solution;
   int num_correspondences = 0;  // of the last correspondence search
+  double match_ms = 0.0;        // wall time in correspondence searches
+  double solve_ms = 0.0;        // ...and in solves
 };
 
 // The outer loop of A-LOAM's odometry and mapping: up to cfg.outer_iterations times, search

@@ -51,6 +51,14 @@ void PointGrid::build(const FeatureCloud& cloud) {
 
 void PointGrid::visit(int64_t x, int64_t y, int64_t z, const Eigen::Vector3f& q, int k, float max_d2,
                       std::vector<int>& idx, std::vector<float>& d2) const {
+  // A cell whose nearest corner is beyond the k-th best (or the radius) cannot contribute.
+  auto gap = [this](int64_t c, float v) {
+    const double lo = c * cell_;
+    return std::max({lo - v, 0.0, v - (lo + cell_)});
+  };
+  const double gx = gap(x, q.x()), gy = gap(y, q.y()), gz = gap(z, q.z());
+  const double box2 = gx * gx + gy * gy + gz * gz;
+  if (box2 >= max_d2 || (static_cast<int>(d2.size()) == k && box2 >= d2.back())) return;
   const int c = cells_.find(key(x, y, z));
   if (c == BlockIndex::kMissing) return;
   for (int j = start_[c]; j < start_[c + 1]; ++j) {

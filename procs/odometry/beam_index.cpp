@@ -29,6 +29,26 @@ BeamModel::BeamModel(const FeatureConfig& cfg)
     }
   }
   bottom_beam_ = beam;
+  if (tan_steps_.empty()) return;
+  lut_lo_ = tan_steps_.back() - 0.01f;
+  lut_hi_ = tan_steps_.front() + 0.01f;
+  const int bins = 16384;
+  lut_scale_ = bins / (lut_hi_ - lut_lo_);
+  lut_.resize(bins);
+  // Each bin's beam at its centre (steps descend: [0, i) lie above t) ...
+  size_t i = tan_steps_.size();
+  for (int b = 0; b < bins; ++b) {
+    const float tc = lut_lo_ + (b + 0.5f) / lut_scale_;
+    while (i > 0 && tan_steps_[i - 1] <= tc) --i;
+    lut_[b] = i == tan_steps_.size() ? bottom_beam_ : step_beams_[i];
+  }
+  // ... except around a step (with beamOf's rounding margin, doubled): there the steps decide.
+  for (float st : tan_steps_) {
+    const float margin = 2e-5f * (std::abs(st) + 1e-3f);
+    const int b0 = std::max(0, static_cast<int>(std::floor((st - margin - lut_lo_) * lut_scale_)) - 1);
+    const int b1 = std::min(bins - 1, static_cast<int>(std::floor((st + margin - lut_lo_) * lut_scale_)) + 1);
+    for (int b = b0; b <= b1; ++b) lut_[b] = kAmbiguous;
+  }
 }
 
 int BeamModel::beamOfAngle(float angle) const {
@@ -48,6 +68,14 @@ int BeamModel::beamOfAngle(float angle) const {
 int BeamModel::beamOf(const Eigen::Vector3f& p) const {
   const float horizontal = std::sqrt(p.x() * p.x() + p.y() * p.y());
   const float t = p.z() / horizontal;
+  if (t >= lut_lo_ && t < lut_hi_) {
+    const int b = std::min(static_cast<int>((t - lut_lo_) * lut_scale_), static_cast<int>(lut_.size()) - 1);
+    if (lut_[b] != kAmbiguous) return lut_[b];
+  }
+  return stepsBeam(t, p, horizontal);
+}
+
+int BeamModel::stepsBeam(float t, const Eigen::Vector3f& p, float horizontal) const {
   // tan_steps_ descends: the first step at or below t.
   const auto it = std::lower_bound(tan_steps_.begin(), tan_steps_.end(), t, [](float s, float v) { return s > v; });
   const size_t i = it - tan_steps_.begin();

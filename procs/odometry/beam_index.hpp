@@ -30,6 +30,12 @@ class BeamModel {
   std::vector<float> tan_steps_;
   std::vector<int> step_beams_;
   int bottom_beam_ = -1;
+  // Uniform bins over [lut_lo_, lut_hi_) of tan(angle): the beam of a bin no step crosses, or
+  // kAmbiguous (then the steps decide): one multiply and one load for nearly every point.
+  static constexpr int kAmbiguous = -2;
+  std::vector<int> lut_;
+  float lut_lo_ = 0.0f, lut_hi_ = 0.0f, lut_scale_ = 0.0f;
+  int stepsBeam(float t, const Eigen::Vector3f& p, float horizontal) const;
 };
 
 }  // namespace dlslot::odometry

@@ -134,22 +134,9 @@ void VoxelLayer::nearest(const Eigen::Vector3f& q, int k, Neighbours& out) const
   range(q.x(), x0, x1);
   range(q.y(), y0, y1);
   range(q.z(), z0, z1);
-  // The block holding q first: its points usually fill the k best, and blocks whose nearest
-  // corner is farther than the k-th best are then skipped without a lookup.
-  auto gap = [this](int64_t c, float v) {
-    const double lo = c * block_;
-    return std::max({lo - v, 0.0, v - (lo + block_)});
-  };
-  const int64_t qx = static_cast<int64_t>(std::floor(q.x() / block_)), qy = static_cast<int64_t>(std::floor(q.y() / block_)),
-                qz = static_cast<int64_t>(std::floor(q.z() / block_));
-  for (int pass = 0; pass < 2; ++pass)
-  for (int64_t bz = pass == 0 ? qz : z0; bz <= (pass == 0 ? qz : z1); ++bz)
-    for (int64_t by = pass == 0 ? qy : y0; by <= (pass == 0 ? qy : y1); ++by)
-      for (int64_t bx = pass == 0 ? qx : x0; bx <= (pass == 0 ? qx : x1); ++bx) {
-        if (pass == 1 && bx == qx && by == qy && bz == qz) continue;
-        const double gx = gap(bx, q.x()), gy = gap(by, q.y()), gz = gap(bz, q.z());
-        const double box2 = gx * gx + gy * gy + gz * gz;
-        if (box2 >= radius2_ || (out.size() == k && box2 >= out.d2.back())) continue;
+  for (int64_t bz = z0; bz <= z1; ++bz)
+    for (int64_t by = y0; by <= y1; ++by)
+      for (int64_t bx = x0; bx <= x1; ++bx) {
         const int b = index_.find(blockKey(bx, by, bz));
         if (b == BlockIndex::kMissing) continue;
         const size_t base = static_cast<size_t>(b) * capacity_;

@@ -1,5 +1,9 @@
 #include "frame_queue.hpp"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <stdexcept>
 
@@ -19,12 +23,15 @@ FrameQueue::~FrameQueue() {
 }
 
 bool FrameQueue::submit(RenderInput in) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  std::unique_lock<std::mutex> lock(mutex_);
   if (stop_) throw std::logic_error("FrameQueue::submit after finish");
   if (skip_when_behind_ && queue_.size() >= max_queued_) {
     ++skipped_;
     return false;
   }
+  // Never skipping, the backlog still has a bound (each frame holds its scan, ~2 MB): past it
+  // the receiving thread waits.
+  idle_.wait(lock, [this] { return queue_.size() < kMaxBacklog || !error_.empty(); });
   queue_.push_back(std::move(in));
   wake_.notify_one();
   return true;
@@ -54,6 +61,9 @@ int FrameQueue::skipped() const {
 }
 
 void FrameQueue::run() {
+  // The lowest CPU priority (Linux nice is per thread): on a shared machine the estimator's
+  // processes get the cores first; the images catch up when they are idle.
+  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
     wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });

@@ -5,7 +5,8 @@
 // When the writer falls behind, a frame that arrives while `max_queued` frames wait is skipped
 // and counted, if skipping is allowed (rate mode: the images keep up with the data, some
 // frames have none). Otherwise every frame is queued and written (lockstep: the pipeline never
-// waits for the renderer, and every frame gets its image, later).
+// waits for the renderer, and every frame gets its image, later; past kMaxBacklog frames the
+// receiving thread waits). The writer thread runs at the lowest CPU priority.
 #pragma once
 
 #include <condition_variable>
@@ -42,6 +43,7 @@ class FrameQueue {
 
  private:
   void run();
+  static constexpr size_t kMaxBacklog = 256;
 
   FrameWriter& writer_;
   const size_t max_queued_;

@@ -61,7 +61,7 @@ TEST(OdometryBoxRemoval, FilteredModeRemovesDetectedPointsBeforeFeatures) {
   EXPECT_EQ(r.num_points_in, car.scan.cols());
   // Nothing of the car made it into the map.
   for (const auto* layer : {&odometry.map().edges(), &odometry.map().planes()})
-    for (const auto& p : layer->cloud()) EXPECT_FALSE(car.detection.contains(p.getVector3fMap().cast<double>(), 0.0));
+    for (const Eigen::Vector3f& p : layer->points()) EXPECT_FALSE(car.detection.contains(p.cast<double>(), 0.0));
 }
 
 TEST(OdometryBoxRemoval, ALoamModeAndMissingDetectionsKeepEverything) {
@@ -77,8 +77,8 @@ TEST(OdometryBoxRemoval, ALoamModeAndMissingDetectionsKeepEverything) {
   EXPECT_FALSE(r1.detections_used);
   EXPECT_EQ(r1.num_points_removed, 0);
   int car_points_in_map = 0;
-  for (const auto& p : plain.map().planes().cloud())
-    car_points_in_map += car.detection.contains(p.getVector3fMap().cast<double>(), 0.0) ? 1 : 0;
+  for (const Eigen::Vector3f& p : plain.map().planes().points())
+    car_points_in_map += car.detection.contains(p.cast<double>(), 0.0) ? 1 : 0;
   EXPECT_GT(car_points_in_map, 0);
 
   LidarOdometry filtered;  // A-LOAM* configured, but this scan's detections never came

@@ -2,6 +2,8 @@
 // plane selection on constructed scans with known geometry.
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include <cmath>
 #include <limits>
 #include <map>
@@ -32,6 +34,22 @@ TEST(OdometryBeamIndex, Hdl64RuleOfALoam) {
   // Every HDL-64E elevation down to beam 50 gets its own index, in order.
   const std::vector<double> elev = test::hdl64ElevationsDeg();
   for (int b = 1; b <= 50; ++b) EXPECT_EQ(model.beamOf(atElevation(elev[b])), b) << "beam " << b;
+}
+
+TEST(OdometryBeamIndex, TableLookupEqualsTheAngleRule) {
+  FeatureConfig uniform;
+  uniform.beam_model = "uniform";
+  uniform.num_beams = 32;
+  for (const FeatureConfig& cfg : {FeatureConfig(), uniform}) {
+    const BeamModel model(cfg);
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> U(-1.0f, 1.0f);
+    for (int i = 0; i < 200000; ++i) {
+      const Eigen::Vector3f p(60.0f * U(rng), 60.0f * U(rng), 8.0f * U(rng));
+      const float angle = std::atan2(p.z(), std::sqrt(p.x() * p.x() + p.y() * p.y())) * static_cast<float>(180.0 / M_PI);
+      ASSERT_EQ(model.beamOf(p), model.beamOfAngle(angle)) << cfg.beam_model << " at " << angle << " deg";
+    }
+  }
 }
 
 TEST(OdometryBeamIndex, UniformModelFromConfig) {

@@ -66,7 +66,7 @@ TEST(OdometryRegistration, ScanToMapRecoversAKnownPose) {
   const test::Scene street = test::street();
   const FeatureConfig fc;
   const ScanToMapConfig cfg;
-  LocalMap map(cfg.edge_voxel_m, cfg.plane_voxel_m, cfg.map_radius_m);
+  LocalMap map(cfg);
   for (double x : {0.0, 1.5, 3.0}) {  // a map from three earlier scans at known poses
     const Pose T = test::planarPose(x, 0.0, 0.0);
     const ScanFeatures f = extractFeatures(street.scan(T), fc);

@@ -1,6 +1,7 @@
 #include "feature_extraction.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <numeric>
 #include <utility>
@@ -63,15 +64,21 @@ class RingSelector {
     const int w = cfg_.curvature_half_window;
     const int first = w, last = static_cast<int>(ring_.cols()) - w - 1;  // inclusive
     if (last - first < cfg_.sectors_per_beam) return;
-    // (curvature, index) pairs sort faster than indices compared through the curvature array.
-    std::vector<std::pair<float, int>> order(ring_.cols());
-    for (int i = 0; i < static_cast<int>(order.size()); ++i) order[i] = {curvature_[i], i};
     for (int s = 0; s < cfg_.sectors_per_beam; ++s) {
       const int sp = first + (last - first) * s / cfg_.sectors_per_beam;
       const int ep = first + (last - first) * (s + 1) / cfg_.sectors_per_beam - 1;
-      std::sort(order.begin() + sp, order.begin() + ep + 1);
-      pickEdges(order, sp, ep, beam, out);
-      pickFlats(order, sp, ep, beam, out);
+      // Edge candidates strongest first, plane candidates flattest first: (curvature, index)
+      // pairs, ordered only as far as the picking reads them (it stops after a few features),
+      // where sorting each whole sector cost 7 % of the odometry's instructions. The pairs are
+      // unique, so the order read is exactly the full sort's.
+      edge_candidates_.clear();
+      flat_candidates_.clear();
+      for (int i = sp; i <= ep; ++i) {
+        if (curvature_[i] > cfg_.edge_curvature_min) edge_candidates_.push_back({curvature_[i], i});
+        if (curvature_[i] < cfg_.plane_curvature_max) flat_candidates_.push_back({curvature_[i], i});
+      }
+      pickEdges(beam, out);
+      pickFlats(beam, out);
     }
     // Everything that is not an edge is a plane candidate for the map, thinned along the ring.
     Eigen::Vector3f last_kept = Eigen::Vector3f::Constant(1e30f);
@@ -84,31 +91,51 @@ class RingSelector {
   }
 
  private:
-  void pickEdges(const std::vector<std::pair<float, int>>& order, int sp, int ep, int beam, ScanFeatures& out) {
+  using Candidate = std::pair<float, int>;
+
+  // Visits `c` in `before` order, ordering it chunk by chunk as the visit proceeds, until
+  // `visit` returns false.
+  template <class Before, class Visit>
+  static void inOrder(std::vector<Candidate>& c, Before before, Visit visit) {
+    size_t ordered = 0;
+    for (size_t k = 0; k < c.size(); ++k) {
+      if (k == ordered) {
+        const size_t next = std::min(c.size(), std::max<size_t>(2 * ordered, 32));
+        if (next < c.size()) std::nth_element(c.begin() + ordered, c.begin() + next - 1, c.end(), before);
+        std::sort(c.begin() + ordered, c.begin() + next, before);
+        ordered = next;
+      }
+      if (!visit(c[k])) return;
+    }
+  }
+
+  void pickEdges(int beam, ScanFeatures& out) {
     int n = 0;
-    for (int k = ep; k >= sp && n < cfg_.less_sharp_per_sector; --k) {
-      const int i = order[k].second;
-      if (curvature_[i] <= cfg_.edge_curvature_min) break;
-      if (picked_[i]) continue;
+    if (cfg_.less_sharp_per_sector <= 0) return;
+    inOrder(edge_candidates_, std::greater<Candidate>(), [&](const Candidate& c) {
+      const int i = c.second;
+      if (picked_[i]) return true;
       ++n;
       label_[i] = n <= cfg_.sharp_per_sector ? kSharp : kLessSharp;
       if (label_[i] == kSharp) out.sharp.push_back(toPoint(ring_.col(i), beam));
       out.less_sharp.push_back(toPoint(ring_.col(i), beam));
       suppressNeighbours(i);
-    }
+      return n < cfg_.less_sharp_per_sector;
+    });
   }
 
-  void pickFlats(const std::vector<std::pair<float, int>>& order, int sp, int ep, int beam, ScanFeatures& out) {
+  void pickFlats(int beam, ScanFeatures& out) {
     int n = 0;
-    for (int k = sp; k <= ep && n < cfg_.flat_per_sector; ++k) {
-      const int i = order[k].second;
-      if (curvature_[i] >= cfg_.plane_curvature_max) break;
-      if (picked_[i]) continue;
+    if (cfg_.flat_per_sector <= 0) return;
+    inOrder(flat_candidates_, std::less<Candidate>(), [&](const Candidate& c) {
+      const int i = c.second;
+      if (picked_[i]) return true;
       ++n;
       label_[i] = kFlat;
       out.flat.push_back(toPoint(ring_.col(i), beam));
       suppressNeighbours(i);
-    }
+      return n < cfg_.flat_per_sector;
+    });
   }
 
   // Curvature across a gap in the ring (no return, or where two lasers share a beam index) compares
@@ -152,6 +179,7 @@ class RingSelector {
   Eigen::VectorXf curvature_;
   std::vector<int8_t> label_;
   std::vector<bool> picked_;
+  std::vector<Candidate> edge_candidates_, flat_candidates_;
 };
 
 }  // namespace

@@ -36,7 +36,7 @@ Matrix6d solveCovariance(const Matrix6d& normal_matrix, const OdometryConfig& cf
 
 LidarOdometry::LidarOdometry(OdometryConfig cfg)
     : cfg_(std::move(cfg)),
-      map_(cfg_.scan_to_map.edge_voxel_m, cfg_.scan_to_map.plane_voxel_m, cfg_.scan_to_map.map_radius_m) {}
+      map_(cfg_.scan_to_map) {}
 
 void LidarOdometry::reset() {
   map_.clear();
@@ -72,7 +72,10 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
     kept = keepOutside(*scan, inside);
     scan = &kept;
   }
+  out.detail.emplace_back("box_removal", msSince(t));
+  const auto t_extract = Clock::now();
   features = extractFeatures(*scan, cfg_.features);
+  out.detail.emplace_back("feature_extraction", msSince(t_extract));
   out.num_edge = static_cast<int>(features.sharp.size());
   out.num_plane = static_cast<int>(features.flat.size());
   out.timings.emplace_back("features", msSince(t));
@@ -99,6 +102,8 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
   if (started_) {
     s2s = moving_ ? registerScanToScan(features, reference_, T_world_reference_.inverse() * prediction, cfg_.scan_to_scan)
                   : registerFirstMotion(features, reference_, cfg_.scan_to_scan);
+    out.detail.emplace_back("s2s_match", s2s.match_ms);
+    out.detail.emplace_back("s2s_solve", s2s.solve_ms);
     out.timings.emplace_back("scan_to_scan", msSince(t));
     if (!s2s.solution.ok) {
       fallBack(Status::FallbackSolveFailed,
@@ -114,12 +119,15 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
   t = Clock::now();
   const FeatureCloud edges = downsample(features.less_sharp, cfg_.scan_to_map.edge_voxel_m);
   const FeatureCloud planes = downsample(features.less_flat, cfg_.scan_to_map.plane_voxel_m);
+  out.detail.emplace_back("s2m_downsample", msSince(t));
   out.num_map_edge = static_cast<int>(map_.edges().size());
   out.num_map_plane = static_cast<int>(map_.planes().size());
   Pose pose = Pose::Identity();
   if (started_) {
     const Registration s2m =
         registerScanToMap(edges, planes, map_, T_world_reference_ * s2s.solution.T_ref_cur, cfg_.scan_to_map);
+    out.detail.emplace_back("s2m_match", s2m.match_ms);
+    out.detail.emplace_back("s2m_solve", s2m.solve_ms);
     const Pose correction = prediction.inverse() * s2m.solution.T_ref_cur;
     std::string failure;
     if (!s2m.solution.ok)
@@ -143,7 +151,9 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
     out.covariance = Matrix6d::Zero();
     pose = T_world_last_;
   }
+  const auto t_map = Clock::now();
   map_.insert(edges, planes, pose);
+  out.detail.emplace_back("map_update", msSince(t_map));
   out.timings.emplace_back("scan_to_map", msSince(t));
 
   out.T_world_lidar = pose;
@@ -153,7 +163,9 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
     moving_ = true;
   }
   T_world_last_ = T_world_reference_ = pose;
+  const auto t_index = Clock::now();
   reference_.reset(features);
+  out.detail.emplace_back("s2s_index", msSince(t_index));  // the next scan's reference
   started_ = true;
   return finish();
 }

@@ -34,6 +34,10 @@ struct OdometryResult {
   int num_correspondences = 0;                // scan-to-map, last search
   double residual_mean = 0.0;                 // scan-to-map inliers, m
   StageTimings timings;                       // features, scan_to_scan, scan_to_map, total (ms)
+  // Inside those stages (ms): box_removal, feature_extraction, s2s_match, s2s_solve,
+  // s2m_downsample, s2m_match, s2m_solve, map_update, s2s_index (the index of this scan for the
+  // next scan-to-scan: in "total" only). For benchmarks; not published.
+  StageTimings detail;
 };
 
 class LidarOdometry {

@@ -2,53 +2,176 @@
 
 #include <pcl/filters/voxel_grid.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace dlslot::odometry {
 
-int64_t VoxelLayer::key(const Eigen::Vector3f& p) const {
-  // 21 bits per axis: +-1e6 voxels, far beyond any local map.
-  auto idx = [this](float v) { return static_cast<int64_t>(std::floor(v / voxel_)) + (int64_t{1} << 20); };
-  return (idx(p.x()) << 42) | (idx(p.y()) << 21) | idx(p.z());
+namespace {
+
+int64_t floorDiv(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+}  // namespace
+
+VoxelLayer::VoxelLayer(double voxel_m, double search_radius_m)
+    : voxel_(voxel_m),
+      m_(std::max(1, static_cast<int>(std::ceil(search_radius_m / voxel_m - 1e-9)))),
+      radius2_(static_cast<float>(search_radius_m * search_radius_m)) {
+  block_ = m_ * voxel_;
+  capacity_ = m_ * m_ * m_;
 }
 
-void VoxelLayer::insert(const FeatureCloud& points) {
+int64_t VoxelLayer::blockKey(int64_t bx, int64_t by, int64_t bz) const {
+  // 21 bits per axis: +-1e6 blocks, far beyond any local map.
+  const int64_t off = int64_t{1} << 20;
+  return ((bx + off) << 42) | ((by + off) << 21) | (bz + off);
+}
+
+void VoxelLayer::insert(const FeatureCloud& points, const Eigen::Isometry3f& T) {
   for (const auto& pt : points) {
-    const Eigen::Vector3f p = pt.getVector3fMap();
-    Cell& c = cells_[key(p)];
+    const Eigen::Vector3f p = T * pt.getVector3fMap();
+    // The voxel grid of the kd-tree map this replaces: floor(v / voxel) in double.
+    const int64_t vx = static_cast<int64_t>(std::floor(p.x() / voxel_));
+    const int64_t vy = static_cast<int64_t>(std::floor(p.y() / voxel_));
+    const int64_t vz = static_cast<int64_t>(std::floor(p.z() / voxel_));
+    const int64_t bx = floorDiv(vx, m_), by = floorDiv(vy, m_), bz = floorDiv(vz, m_);
+    const int slot = static_cast<int>(((vz - bz * m_) * m_ + (vy - by * m_)) * m_ + (vx - bx * m_));
+    const int64_t key = blockKey(bx, by, bz);
+    int b = index_.find(key);
+    if (b == BlockIndex::kMissing) {
+      b = static_cast<int>(blocks_.size());
+      blocks_.push_back({key, bx, by, bz, 0});
+      index_.set(key, b);
+      means_.resize(blocks_.size() * capacity_);
+      counts_.resize(blocks_.size() * capacity_);
+      slots_.resize(blocks_.size() * capacity_);
+    }
+    Block& block = blocks_[b];
+    const size_t base = static_cast<size_t>(b) * capacity_;
+    int i = 0;
+    while (i < block.n && slots_[base + i] != slot) ++i;
+    if (i == block.n) {
+      slots_[base + i] = slot;
+      counts_[base + i] = 0;
+      ++block.n;
+      ++num_points_;
+    }
     // A running mean averages the range noise of repeated observations of the same surface.
-    c.mean = c.count == 0 ? p : Eigen::Vector3f(c.mean + (p - c.mean) / static_cast<float>(c.count + 1));
-    ++c.count;
+    Eigen::Vector3f& mean = means_[base + i];
+    int& count = counts_[base + i];
+    mean = count == 0 ? p : Eigen::Vector3f(mean + (p - mean) / static_cast<float>(count + 1));
+    ++count;
   }
+}
+
+void VoxelLayer::removePoint(size_t b, int i) {
+  const size_t base = b * capacity_;
+  const int last = --blocks_[b].n;
+  means_[base + i] = means_[base + last];
+  counts_[base + i] = counts_[base + last];
+  slots_[base + i] = slots_[base + last];
+  --num_points_;
+}
+
+void VoxelLayer::removeBlock(size_t b) {
+  num_points_ -= blocks_[b].n;
+  index_.erase(blocks_[b].key);
+  const size_t last = blocks_.size() - 1;
+  if (b != last) {
+    blocks_[b] = blocks_[last];
+    std::copy_n(means_.begin() + last * capacity_, blocks_[b].n, means_.begin() + b * capacity_);
+    std::copy_n(counts_.begin() + last * capacity_, blocks_[b].n, counts_.begin() + b * capacity_);
+    std::copy_n(slots_.begin() + last * capacity_, blocks_[b].n, slots_.begin() + b * capacity_);
+    index_.set(blocks_[b].key, static_cast<int>(b));
+  }
+  blocks_.pop_back();
 }
 
 void VoxelLayer::crop(const Eigen::Vector3d& center, double radius) {
   const float r2 = static_cast<float>(radius * radius);
   const Eigen::Vector2f c = center.head<2>().cast<float>();
-  cloud_.reset(new FeatureCloud);
-  cloud_->reserve(cells_.size());
-  for (auto it = cells_.begin(); it != cells_.end();) {
-    if ((it->second.mean.head<2>() - c).squaredNorm() > r2) {
-      it = cells_.erase(it);
+  // Whole blocks are kept or dropped by their horizontal extent; only blocks the circle cuts
+  // are decided voxel by voxel (with the same float test as per voxel, so the result is exact).
+  const double margin = 1e-3;
+  for (size_t b = blocks_.size(); b-- > 0;) {
+    const Block& block = blocks_[b];
+    const double x0 = block.bx * block_, y0 = block.by * block_;
+    const double dx_near = std::max({x0 - center.x(), 0.0, center.x() - (x0 + block_)});
+    const double dy_near = std::max({y0 - center.y(), 0.0, center.y() - (y0 + block_)});
+    const double dx_far = std::max(std::abs(x0 - center.x()), std::abs(x0 + block_ - center.x()));
+    const double dy_far = std::max(std::abs(y0 - center.y()), std::abs(y0 + block_ - center.y()));
+    if (std::hypot(dx_far, dy_far) < radius - margin) continue;
+    if (std::hypot(dx_near, dy_near) > radius + margin) {
+      removeBlock(b);
       continue;
     }
-    pcl::PointXYZI q;
-    q.getVector3fMap() = it->second.mean;
-    q.intensity = 0.0f;
-    cloud_->push_back(q);
-    ++it;
+    const size_t base = b * capacity_;
+    for (int i = blocks_[b].n; i-- > 0;)
+      if ((means_[base + i].head<2>() - c).squaredNorm() > r2) removePoint(b, i);
+    if (blocks_[b].n == 0) removeBlock(b);
   }
-  if (!cloud_->empty()) tree_.setInputCloud(cloud_);
 }
 
 void VoxelLayer::clear() {
-  cells_.clear();
-  cloud_.reset(new FeatureCloud);
+  blocks_.clear();
+  index_.clear();
+  means_.clear();
+  counts_.clear();
+  slots_.clear();
+  num_points_ = 0;
+}
+
+void VoxelLayer::nearest(const Eigen::Vector3f& q, int k, Neighbours& out) const {
+  out.d2.clear();
+  out.points.clear();
+  if (blocks_.empty() || k <= 0) return;
+  const double r = std::sqrt(static_cast<double>(radius2_));
+  auto range = [&](float v, int64_t& lo, int64_t& hi) {
+    lo = static_cast<int64_t>(std::floor((v - r) / block_));
+    hi = static_cast<int64_t>(std::floor((v + r) / block_));
+  };
+  int64_t x0, x1, y0, y1, z0, z1;
+  range(q.x(), x0, x1);
+  range(q.y(), y0, y1);
+  range(q.z(), z0, z1);
+  for (int64_t bz = z0; bz <= z1; ++bz)
+    for (int64_t by = y0; by <= y1; ++by)
+      for (int64_t bx = x0; bx <= x1; ++bx) {
+        const int b = index_.find(blockKey(bx, by, bz));
+        if (b == BlockIndex::kMissing) continue;
+        const size_t base = static_cast<size_t>(b) * capacity_;
+        for (int i = 0; i < blocks_[b].n; ++i) {
+          const Eigen::Vector3f& p = means_[base + i];
+          const float d2 = (p - q).squaredNorm();
+          if (d2 >= radius2_ || (out.size() == k && d2 >= out.d2.back())) continue;
+          // Insertion into the sorted k best.
+          if (out.size() < k) {
+            out.d2.push_back(d2);
+            out.points.push_back(p);
+          }
+          int j = out.size() - 1;
+          for (; j > 0 && out.d2[j - 1] > d2; --j) {
+            out.d2[j] = out.d2[j - 1];
+            out.points[j] = out.points[j - 1];
+          }
+          out.d2[j] = d2;
+          out.points[j] = p;
+        }
+      }
+}
+
+std::vector<Eigen::Vector3f> VoxelLayer::points() const {
+  std::vector<Eigen::Vector3f> out;
+  out.reserve(num_points_);
+  for (size_t b = 0; b < blocks_.size(); ++b)
+    out.insert(out.end(), means_.begin() + b * capacity_, means_.begin() + b * capacity_ + blocks_[b].n);
+  return out;
 }
 
 void LocalMap::insert(const FeatureCloud& edges, const FeatureCloud& planes, const Pose& T_world_lidar) {
-  edges_.insert(transformed(edges, T_world_lidar));
-  planes_.insert(transformed(planes, T_world_lidar));
+  const Eigen::Isometry3f T = T_world_lidar.cast<float>();
+  edges_.insert(edges, T);
+  planes_.insert(planes, T);
   edges_.crop(T_world_lidar.translation(), radius_);
   planes_.crop(T_world_lidar.translation(), radius_);
 }
@@ -66,13 +189,6 @@ FeatureCloud downsample(const FeatureCloud& cloud, double voxel_m) {
   grid.setLeafSize(v, v, v);
   grid.setInputCloud(FeatureCloud::ConstPtr(&cloud, [](const FeatureCloud*) {}));
   grid.filter(out);
-  return out;
-}
-
-FeatureCloud transformed(const FeatureCloud& cloud, const Pose& T) {
-  FeatureCloud out = cloud;
-  const Eigen::Isometry3f Tf = T.cast<float>();
-  for (auto& p : out.points) p.getVector3fMap() = Tf * p.getVector3fMap();
   return out;
 }
 

@@ -1,11 +1,11 @@
 #include "pose_solver.hpp"
 
-#include <ceres/ceres.h>
-
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <chrono>
+#include <cmath>
 
-#include "edge_residual.hpp"
-#include "plane_residual.hpp"
+#include "normal_equations.hpp"
 
 namespace dlslot::odometry {
 
@@ -22,66 +22,55 @@ Matches expressedIn(const Matches& m, const Pose& T_ref_new) {
   return out;
 }
 
-namespace {
-
-// sum(rho' J^T J) and inlier residual statistics at x = 0 (matches expressed in the solution frame).
-void measureConstraint(const Matches& m, const ceres::LossFunction& loss, double huber_delta, PoseSolution& s) {
+// The robust normal matrix and inlier statistics of the correspondences at the solution
+// (matches re-expressed in the solution frame, x = 0).
+void measureConstraint(const Matches& matches, double huber_delta, PoseSolution& s) {
   const double zero[6] = {0, 0, 0, 0, 0, 0};
-  const double* params[1] = {zero};
-  double sum_abs = 0.0;
-  auto add = [&](const ceres::CostFunction& cost, int dim) {
-    double r[3], jac[18];
-    double* jacs[1] = {jac};
-    cost.Evaluate(params, r, jacs);
-    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>> J(jac, dim, 6);
-    const double sq = Eigen::Map<const Eigen::VectorXd>(r, dim).squaredNorm();
-    double rho[3];
-    loss.Evaluate(sq, rho);
-    s.normal_matrix += rho[1] * J.transpose() * J;
-    if (sq <= huber_delta * huber_delta) {
-      sum_abs += std::sqrt(sq);
-      ++s.num_inliers;
-    }
-  };
-  RigidMotion motion;
-  for (const EdgeMatch& e : m.edges) add(EdgeResidual(e.p, e.a, e.u, motion), 3);
-  for (const PlaneMatch& p : m.planes) add(PlaneResidual(p.p, p.n, p.d, motion), 1);
-  s.residual_mean = s.num_inliers > 0 ? sum_abs / s.num_inliers : 0.0;
+  const NormalEquations ne = linearize(expressedIn(matches, s.T_ref_cur), zero, huber_delta);
+  s.normal_matrix = ne.H;
+  s.num_inliers = ne.num_inliers;
+  s.residual_mean = ne.num_inliers > 0 ? ne.sum_abs_inliers / ne.num_inliers : 0.0;
   s.min_eigenvalue = Eigen::SelfAdjointEigenSolver<Matrix6d>(s.normal_matrix, Eigen::EigenvaluesOnly).eigenvalues()[0];
 }
-
-}  // namespace
 
 PoseSolution solvePose(const Matches& matches, const Pose& guess, const SolverConfig& cfg) {
   PoseSolution sol;
   sol.T_ref_cur = guess;
   if (matches.size() == 0) return sol;
 
-  // Parameters are the correction x to the guess (T_ref_cur = guess * T(x)), starting at zero.
+  // Levenberg-Marquardt on the 6x6 normal equations, as Ceres runs it for this problem: the
+  // correction x to the guess (T_ref_cur = guess * T(x)) starts at zero, a step solves
+  // (H + lambda diag(H)) dx = -g, and is kept only when it lowers the robust cost; lambda
+  // starts at Ceres' 1 / initial trust region radius (1e-4), shrinks after a kept step and grows
+  // after a rejected one. Every try counts as one of cfg.solver_iterations.
   const Matches local = expressedIn(matches, guess);
-  double x[6] = {0, 0, 0, 0, 0, 0};
-  ceres::HuberLoss loss(cfg.huber_delta_m);
-  RigidMotion motion;  // outlives the problem's residuals, which refer to it
-  ceres::Problem::Options problem_options;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.enable_fast_removal = false;
-  ceres::Problem problem(problem_options);
-  for (const EdgeMatch& e : local.edges) problem.AddResidualBlock(new EdgeResidual(e.p, e.a, e.u, motion), &loss, x);
-  for (const PlaneMatch& p : local.planes)
-    problem.AddResidualBlock(new PlaneResidual(p.p, p.n, p.d, motion), &loss, x);
+  Vector6d x = Vector6d::Zero();
+  NormalEquations ne = linearize(local, x.data(), cfg.huber_delta_m);
+  if (!std::isfinite(ne.cost)) return sol;
+  double lambda = 1e-4;
+  for (int it = 0; it < cfg.solver_iterations; ++it) {
+    Matrix6d A = ne.H;
+    A.diagonal() += lambda * ne.H.diagonal().cwiseMax(1e-6);
+    const Vector6d dx = A.ldlt().solve(-ne.g);
+    if (!dx.allFinite()) break;
+    const Vector6d x_new = x + dx;
+    NormalEquations next = linearize(local, x_new.data(), cfg.huber_delta_m);
+    if (std::isfinite(next.cost) && next.cost < ne.cost) {
+      const double decrease = (ne.cost - next.cost) / std::max(ne.cost, 1e-300);
+      x = x_new;
+      ne = std::move(next);
+      lambda = std::max(lambda / 3.0, 1e-12);
+      // Ceres' function and parameter tolerances: further steps would change nothing.
+      if (decrease < 1e-6 || dx.norm() <= 1e-8 * (x.norm() + 1e-8)) break;
+    } else {
+      lambda *= 4.0;
+    }
+  }
+  if (!x.allFinite()) return sol;
 
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;  // 6 unknowns: the normal matrix is tiny
-  options.max_num_iterations = cfg.solver_iterations;
-  options.num_threads = 1;
-  options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
-  if (!summary.IsSolutionUsable() || !Eigen::Map<const Vector6d>(x).allFinite()) return sol;
-
-  sol.T_ref_cur = orthonormalized(guess * poseFromParams(x));
+  sol.T_ref_cur = orthonormalized(guess * poseFromParams(x.data()));
   sol.ok = true;
-  measureConstraint(expressedIn(matches, sol.T_ref_cur), loss, cfg.huber_delta_m, sol);
+  measureConstraint(matches, cfg.huber_delta_m, sol);
   return sol;
 }
 
@@ -89,15 +78,21 @@ Registration registerIteratively(const std::function<Matches(const Pose&)>& matc
                                  const SolverConfig& cfg, int min_correspondences) {
   Registration r;
   r.solution.T_ref_cur = guess;
+  using Clock = std::chrono::steady_clock;
+  auto ms = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
   for (int it = 0; it < cfg.outer_iterations; ++it) {
+    auto t = Clock::now();
     const Matches m = match(r.solution.T_ref_cur);
+    r.match_ms += ms(t);
     r.num_correspondences = static_cast<int>(m.size());
     if (r.num_correspondences < min_correspondences) {
       r.solution.ok = false;
       break;
     }
     const Pose before = r.solution.T_ref_cur;
+    t = Clock::now();
     r.solution = solvePose(m, before, cfg);
+    r.solve_ms += ms(t);
     if (!r.solution.ok) break;
     // Correspondences searched at a pose this close to the solution would be the same ones.
     const Pose step = before.inverse() * r.solution.T_ref_cur;

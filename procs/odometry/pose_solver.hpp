@@ -1,6 +1,8 @@
 // One registration solve shared by scan-to-scan and scan-to-map: point-to-line and
-// point-to-plane correspondences, Ceres Levenberg-Marquardt with a Huber loss, and how well the
-// result is constrained (the normal matrix J^T J at the solution and its smallest eigenvalue).
+// point-to-plane correspondences, Levenberg-Marquardt with a Huber loss on the 6x6 normal
+// equations (normal_equations.hpp; Ceres' solve of the same problem is kept as the reference),
+// and how well the result is constrained (the normal matrix J^T J at the solution and its
+// smallest eigenvalue).
 #pragma once
 
 #include <Eigen/Core>
@@ -33,7 +35,7 @@ struct Matches {
 
 struct PoseSolution {
   Pose T_ref_cur = Pose::Identity();
-  bool ok = false;               // Ceres returned a usable, finite solution
+  bool ok = false;               // the solve returned a usable, finite solution
   // Robust-weighted normal matrix sum(rho' J^T J) at the solution, for a right perturbation
   // T_ref_cur * (Exp(w), t) in tangent order (t, w); its smallest eigenvalue says how well the
   // worst-constrained direction is determined (near 0: degenerate, e.g. a corridor).
@@ -45,10 +47,16 @@ struct PoseSolution {
 
 // Solves for T_ref_cur from `guess`; matches are in the reference frame.
 PoseSolution solvePose(const Matches& matches, const Pose& guess, const SolverConfig& cfg);
+// The same solve by Ceres (pose_solver_ceres.cpp): the reference for tests and the benchmark.
+PoseSolution solvePoseCeres(const Matches& matches, const Pose& guess, const SolverConfig& cfg);
+// Fills s.normal_matrix, min_eigenvalue, residual_mean and num_inliers at s.T_ref_cur.
+void measureConstraint(const Matches& matches, double huber_delta, PoseSolution& s);
 
 struct Registration {
   PoseSolution solution;
   int num_correspondences = 0;  // of the last correspondence search
+  double match_ms = 0.0;        // wall time in correspondence searches
+  double solve_ms = 0.0;        // ...and in solves
 };
 
 // The outer loop of A-LOAM's odometry and mapping: up to cfg.outer_iterations times, search

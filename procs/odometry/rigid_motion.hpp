@@ -78,6 +78,9 @@ class RigidMotion {
     }
     return Rp + t_;
   }
+  const Eigen::Matrix3d& rotation() const { return R_; }
+  const Eigen::Vector3d& translation() const { return t_; }
+  const Eigen::Matrix3d& leftJacobian() const { return Jl_; }
 
  private:
   double x_[6] = {NAN, NAN, NAN, NAN, NAN, NAN};  // never equal: the first at() computes

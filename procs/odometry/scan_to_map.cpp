@@ -6,15 +6,13 @@ namespace dlslot::odometry {
 
 namespace {
 
-// The k nearest map points of q, or false when the farthest is beyond max_dist.
-bool neighbours(const VoxelLayer& layer, const Eigen::Vector3f& q, int k, double max_dist, Eigen::Matrix3Xd& out,
-                std::vector<int>& idx, std::vector<float>& d2) {
-  if (layer.size() < static_cast<size_t>(k)) return false;
-  pcl::PointXYZI p;
-  p.getVector3fMap() = q;
-  if (layer.tree().nearestKSearch(p, k, idx, d2) < k || d2[k - 1] >= max_dist * max_dist) return false;
+// The k nearest map points of q as columns of `out`, or false when there are not k within the
+// search radius (cfg.max_neighbor_distance_m, the map's).
+bool neighbours(const VoxelLayer& layer, const Eigen::Vector3f& q, int k, Neighbours& nb, Eigen::Matrix3Xd& out) {
+  layer.nearest(q, k, nb);
+  if (nb.size() < k) return false;
   out.resize(3, k);
-  for (int j = 0; j < k; ++j) out.col(j) = layer.cloud()[idx[j]].getVector3fMap().cast<double>();
+  for (int j = 0; j < k; ++j) out.col(j) = nb.points[j].cast<double>();
   return true;
 }
 
@@ -23,16 +21,17 @@ bool neighbours(const VoxelLayer& layer, const Eigen::Vector3f& q, int k, double
 Matches matchScanToMap(const FeatureCloud& edges, const FeatureCloud& planes, const LocalMap& map,
                        const Pose& T_world_lidar, const ScanToMapConfig& cfg) {
   Matches m;
+  m.edges.reserve(edges.size());
+  m.planes.reserve(planes.size());
   const Eigen::Isometry3f T = T_world_lidar.cast<float>();
   Eigen::Matrix3Xd nb;
-  std::vector<int> idx(cfg.neighbors);
-  std::vector<float> d2(cfg.neighbors);
+  Neighbours found;
 
   // An edge point matches the line through its neighbours when they are spread along one
   // direction (largest covariance eigenvalue dominates the second).
   for (const auto& pt : edges) {
     const Eigen::Vector3f p = pt.getVector3fMap();
-    if (!neighbours(map.edges(), T * p, cfg.neighbors, cfg.max_neighbor_distance_m, nb, idx, d2)) continue;
+    if (!neighbours(map.edges(), T * p, cfg.neighbors, found, nb)) continue;
     const Eigen::Vector3d mean = nb.rowwise().mean();
     const Eigen::Matrix3Xd centred = nb.colwise() - mean;
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
@@ -44,7 +43,7 @@ Matches matchScanToMap(const FeatureCloud& edges, const FeatureCloud& planes, co
   // A plane point matches the plane fitted to its neighbours when every neighbour lies on it.
   for (const auto& pt : planes) {
     const Eigen::Vector3f p = pt.getVector3fMap();
-    if (!neighbours(map.planes(), T * p, cfg.neighbors, cfg.max_neighbor_distance_m, nb, idx, d2)) continue;
+    if (!neighbours(map.planes(), T * p, cfg.neighbors, found, nb)) continue;
     const Eigen::Vector3d mean = nb.rowwise().mean();
     const Eigen::Matrix3Xd centred = nb.colwise() - mean;
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;

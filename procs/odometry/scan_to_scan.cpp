@@ -5,10 +5,10 @@
 namespace dlslot::odometry {
 
 void ScanReference::reset(const ScanFeatures& f) {
-  *edges_ = f.less_sharp;
-  *planes_ = f.less_flat;
-  if (!edges_->empty()) edge_tree_.setInputCloud(edges_);
-  if (!planes_->empty()) plane_tree_.setInputCloud(planes_);
+  edges_ = f.less_sharp;
+  planes_ = f.less_flat;
+  edge_grid_.build(edges_);
+  plane_grid_.build(planes_);
 }
 
 namespace {
@@ -21,12 +21,8 @@ struct Candidates {
   std::vector<int> idx;
   std::vector<float> d2;
 };
-void nearestCandidates(const pcl::KdTreeFLANN<pcl::PointXYZI>& tree, const pcl::PointXYZI& q, int k, double max_dist2,
-                       Candidates& c) {
-  const int n = tree.nearestKSearch(q, k, c.idx, c.d2);
-  int keep = 0;
-  while (keep < n && c.d2[keep] < max_dist2) ++keep;
-  c.idx.resize(keep);
+void nearestCandidates(const PointGrid& grid, const Eigen::Vector3f& q, int k, double max_dist2, Candidates& c) {
+  grid.nearest(q, k, static_cast<float>(max_dist2), c.idx, c.d2);
 }
 
 // The closest candidate after the first whose beam satisfies `accept(beam, beam of the first)`
@@ -48,18 +44,14 @@ Matches matchScanToScan(const ScanFeatures& current, const ScanReference& previo
   Matches m;
   Candidates c;
   const double max_d2 = cfg.max_match_distance_m * cfg.max_match_distance_m;
-  auto moved = [&](const pcl::PointXYZI& p) {
-    pcl::PointXYZI q = p;
-    q.getVector3fMap() = (T_prev_cur * vec(p)).cast<float>();
-    return q;
-  };
+  auto moved = [&](const pcl::PointXYZI& p) -> Eigen::Vector3f { return (T_prev_cur * vec(p)).cast<float>(); };
 
   // Edge point -> the line through its nearest previous edge point and the nearest edge point
   // of a neighbouring beam.
   if (!previous.edges().empty()) {
     const FeatureCloud& ref = previous.edges();
     for (const auto& p : current.sharp) {
-      nearestCandidates(previous.edgeTree(), moved(p), cfg.candidates, max_d2, c);
+      nearestCandidates(previous.edgeGrid(), moved(p), cfg.candidates, max_d2, c);
       if (c.idx.empty()) continue;
       const int a = c.idx[0];
       const int b = closestOf(c, ref, cfg.nearby_beams, [](int beam, int beam0) { return beam != beam0; });
@@ -75,7 +67,7 @@ Matches matchScanToScan(const ScanFeatures& current, const ScanReference& previo
   if (!previous.planes().empty()) {
     const FeatureCloud& ref = previous.planes();
     for (const auto& p : current.flat) {
-      nearestCandidates(previous.planeTree(), moved(p), cfg.candidates, max_d2, c);
+      nearestCandidates(previous.planeGrid(), moved(p), cfg.candidates, max_d2, c);
       if (c.idx.empty()) continue;
       const int a = c.idx[0];
       const int b = closestOf(c, ref, cfg.nearby_beams, [](int beam, int beam0) { return beam == beam0; });

@@ -3,26 +3,26 @@
 // less-flat points, and T_prev_cur is solved from the constant-velocity guess.
 #pragma once
 
-#include <pcl/kdtree/kdtree_flann.h>
-
 #include "feature_extraction.hpp"
+#include "point_grid.hpp"
 #include "pose_solver.hpp"
 
 namespace dlslot::odometry {
 
-// The previous scan's features with kd-trees over them.
+// The previous scan's features with nearest-neighbour grids over them. Edge points are sparse
+// (coarse cells keep the number of empty cells visited small), plane points dense.
 class ScanReference {
  public:
   void reset(const ScanFeatures& features);
-  bool empty() const { return edges_->empty() && planes_->empty(); }
-  const FeatureCloud& edges() const { return *edges_; }
-  const FeatureCloud& planes() const { return *planes_; }
-  const pcl::KdTreeFLANN<pcl::PointXYZI>& edgeTree() const { return edge_tree_; }
-  const pcl::KdTreeFLANN<pcl::PointXYZI>& planeTree() const { return plane_tree_; }
+  bool empty() const { return edges_.empty() && planes_.empty(); }
+  const FeatureCloud& edges() const { return edges_; }
+  const FeatureCloud& planes() const { return planes_; }
+  const PointGrid& edgeGrid() const { return edge_grid_; }
+  const PointGrid& planeGrid() const { return plane_grid_; }
 
  private:
-  FeatureCloud::Ptr edges_{new FeatureCloud}, planes_{new FeatureCloud};
-  pcl::KdTreeFLANN<pcl::PointXYZI> edge_tree_, plane_tree_;
+  FeatureCloud edges_, planes_;
+  PointGrid edge_grid_{3.0}, plane_grid_{1.0};  // fastest of 0.25-3 m on the real slice
 };
 
 // Correspondences of the current scan's sharp/flat points at T_prev_cur.

@@ -10,6 +10,7 @@
 #include "dlslot/input_error.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/progress.hpp"
+#include "frame_queue.hpp"
 #include "frame_writer.hpp"
 #include "message_feed.hpp"
 #include "render_config.hpp"
@@ -21,23 +22,36 @@ using namespace dlslot;
 using namespace dlslot::renderer;
 using Clock = std::chrono::steady_clock;
 
-// Draws frames as RunState releases them and keeps the status counters.
+// Hands frames to the writer thread as RunState releases them and keeps the status counters.
 class FrameSink {
  public:
-  FrameSink(FrameWriter& writer, ProcessStatus& status) : writer_(writer), status_(status) {}
+  FrameSink(FrameWriter& writer, ProcessStatus& status, bool skip_when_behind)
+      : queue_(writer, kMaxQueued, skip_when_behind), status_(status) {}
   void draw(std::vector<RenderInput> frames) {
-    for (const RenderInput& in : frames) {
-      const auto t0 = Clock::now();
-      writer_.write(in);
-      status_.frameDone(in.frame, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
-      if (!in.has_tracks) status_.count("frames_without_slot_state");
+    for (RenderInput& in : frames)
+      if (!queue_.submit(std::move(in))) status_.count("frames_skipped");
+    collect();
+  }
+  // Counts the frames written since the last call (the status is this thread's only).
+  void collect() {
+    for (const FrameQueue::Written& w : queue_.takeWritten()) {
+      status_.frameDone(w.frame, w.ms);
+      if (!w.has_tracks) status_.count("frames_without_slot_state");
       ++written_;
     }
   }
+  // Waits for every queued frame.
+  void finish() {
+    queue_.finish();
+    collect();
+  }
   int written() const { return written_; }
+  int skipped() const { return queue_.skipped(); }
 
  private:
-  FrameWriter& writer_;
+  // Frames waiting for the writer before newer ones are skipped (when skipping is allowed).
+  static constexpr int kMaxQueued = 2;
+  FrameQueue queue_;
   ProcessStatus& status_;
   int written_ = 0;
 };
@@ -45,7 +59,8 @@ class FrameSink {
 void report(const FrameSink& sink, const std::string& out, const std::string& summary, const ProcessStatus& status) {
   const process_status_t s = status.toMessage();
   std::cerr << "dlslot-renderer: wrote " << sink.written() << " frames to " << out << " (render+write mean "
-            << s.time_mean_ms << " ms, p95 " << s.time_p95_ms << " ms)";
+            << s.time_mean_ms << " ms, p95 " << s.time_p95_ms << " ms, on the writer thread)";
+  if (sink.skipped()) std::cerr << ", " << sink.skipped() << " frames skipped (the writer was behind)";
   if (!summary.empty()) std::cerr << ", summary " << summary;
   if (s.decode_errors) std::cerr << ", " << s.decode_errors << " undecodable messages";
   int64_t refused = 0;
@@ -68,7 +83,7 @@ int renderLog(const std::string& log_path, const std::string& out, const Rendere
   RunState state(cfg.max_pending_frames, cfg.trail_frames);
   MessageFeed feed(state, status, channels);
   FrameWriter writer(out, cfg);
-  FrameSink sink(writer, status);
+  FrameSink sink(writer, status, false);
   ProgressLine progress("render", scans);
   while (const lcm::LogEvent* e = log.readNextEvent()) {
     feed.handle(e->channel, e->data, e->datalen);
@@ -76,6 +91,7 @@ int renderLog(const std::string& log_path, const std::string& out, const Rendere
     progress.update(sink.written());
   }
   sink.draw(state.takeAll());
+  sink.finish();
   const std::string summary = writer.writeSummary(state.summary());
   progress.update(sink.written());
   progress.finish();
@@ -83,12 +99,13 @@ int renderLog(const std::string& log_path, const std::string& out, const Rendere
   return 0;
 }
 
-int renderLive(const NodeOptions& opts, const std::string& out, const RendererConfig& cfg, const Channels& channels) {
+int renderLive(const NodeOptions& opts, const std::string& out, const RendererConfig& cfg, const Channels& channels,
+               bool skip_when_behind) {
   Node node("renderer", opts.lcm_url, channels);
   RunState state(cfg.max_pending_frames, cfg.trail_frames);
   MessageFeed feed(state, node.status(), channels);
   FrameWriter writer(out, cfg);
-  FrameSink sink(writer, node.status());
+  FrameSink sink(writer, node.status(), skip_when_behind);
   auto last_message = Clock::now();
 
   auto on = [&](auto handler) {
@@ -106,6 +123,7 @@ int renderLive(const NodeOptions& opts, const std::string& out, const RendererCo
   node.subscribeFrames<slot_state_t>(channels.slot_state, on(&MessageFeed::onSlotState));
   // Nothing new for a while: draw what is there (the last frame of a run, a stalled pipeline).
   node.every(0.05, [&] {
+    sink.collect();
     if (!state.hasPending() ||
         std::chrono::duration<double>(Clock::now() - last_message).count() < cfg.frame_timeout_s)
       return;
@@ -116,6 +134,7 @@ int renderLive(const NodeOptions& opts, const std::string& out, const RendererCo
   });
   const int rc = node.run();
   sink.draw(state.takeAll());
+  sink.finish();
   const std::string summary = writer.writeSummary(state.summary());
   report(sink, out, summary, node.status());
   return rc;
@@ -127,12 +146,16 @@ int main(int argc, char** argv) {
   return runMain("dlslot-renderer", [&] {
     NodeOptions opts;
     std::string out, log;
+    bool skip_when_behind = false;
     CommandLine cl("dlslot-renderer",
                    "Writes a bird's-eye PNG per frame (OUT/NNNNNN.png) and a run summary (OUT/summary.png),\n"
                    "live from LCM or, with --log, from a recorded LCM log.");
     opts.addTo(cl);
     cl.option("--out", &out, "output directory for the images (required)");
     cl.option("--log", &log, "render a recorded LCM log instead of live traffic");
+    cl.flag("--skip-when-behind", &skip_when_behind,
+            "live: skip (and count) frames that arrive while the writer is behind (rate mode); "
+            "default: every frame is written, late if need be (lockstep)");
     if (!cl.parse(argc, argv)) return 0;
     Channels channels;
     ConfigSection root = loadPipelineConfig(opts.config, channels);
@@ -142,6 +165,6 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (out.empty()) throw std::invalid_argument("--out DIR is required (see --help)");
-    return log.empty() ? renderLive(opts, out, cfg, channels) : renderLog(log, out, cfg, channels);
+    return log.empty() ? renderLive(opts, out, cfg, channels, skip_when_behind) : renderLog(log, out, cfg, channels);
   });
 }

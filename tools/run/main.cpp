@@ -126,7 +126,11 @@ int runPipeline(int argc, char** argv) {
   std::vector<std::string> pipeline = {"backend", "tracker", "odometry"};
   if (!no_render) {
     pipeline.insert(pipeline.begin(), "renderer");
-    sup.start("renderer", args(bin + "/dlslot-renderer", {"--out", out + "/bev"}), logs + "/renderer.log");
+    // Rate mode: the images keep up with the data (frames skipped when the writer is behind);
+    // lockstep: every frame gets its image.
+    std::vector<std::string> render_args = {"--out", out + "/bev"};
+    if (speed > 0) render_args.push_back("--skip-when-behind");
+    sup.start("renderer", args(bin + "/dlslot-renderer", render_args), logs + "/renderer.log");
   }
   sup.start("backend", args(bin + "/dlslot-backend", {"--mode", ms.backend}), logs + "/backend.log");
   sup.start("tracker", args(bin + "/dlslot-tracker", {}), logs + "/tracker.log");

@@ -36,6 +36,8 @@ inline associations_t associationsMsg(const BackendInput& in) {
     as.box_lidar = toMsg(obs.box);
     as.box_world = toMsg(obs.box);
     as.is_dynamic = obs.dynamic_guess;
+    as.status = obs.confirmed ? association_t::STATUS_CONFIRMED : association_t::STATUS_TENTATIVE;
+    as.confidence = obs.confidence;
     a.associations.push_back(as);
   }
   // A malformed box (NaN size) must be skipped and counted, never be fatal.

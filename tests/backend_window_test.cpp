@@ -417,3 +417,40 @@ TEST(BackendSlidingWindow, RejectsFramesOutOfOrder) {
   window.process(in);
   EXPECT_THROW(window.process(in), std::invalid_argument);
 }
+
+// The reported velocity of a car driving at constant velocity behind 0.15 m box noise: the chain's
+// displacement over velocity_frames frames is less noisy than the newest pose change (0.235 vs 0.330 m/s).
+double velocityRmse(int velocity_frames) {
+  SimScene scene;
+  scene.ego = constantTwist(Pose::Identity(), 10.0, 0.0);
+  SimObject car;
+  car.id = 1;
+  car.pose = constantTwist(planarPose(15, 3.5, 0), 13.0, 0.0);
+  car.dynamic_guess = true;
+  scene.objects = {car};
+  scene.box_noise = Eigen::Vector3d(0.15, 0.15, 0.05);
+  scene.yaw_noise = 0.02;
+  scene.seed = 4;
+  BackendConfig c = streetConfig();
+  c.velocity_frames = velocity_frames;
+  SlidingWindow window(c);
+  double sum = 0;
+  int n = 0;
+  for (const BackendInput& in : scene.generate(80)) {
+    const BackendOutput out = window.process(in);
+    if (in.frame < 20) continue;
+    for (const TrackEstimate& e : out.tracks) {
+      sum += (e.velocity.head<2>() - Eigen::Vector2d(13.0, 0.0)).squaredNorm();
+      ++n;
+    }
+  }
+  EXPECT_GT(n, 50);
+  return std::sqrt(sum / n);
+}
+
+TEST(BackendWindow, VelocityFromTheChainOverSeveralFramesIsLessNoisy) {
+  const double newest_change = velocityRmse(1), five_frames = velocityRmse(5);
+  std::printf("velocity RMSE: newest pose change %.3f m/s, chain over 5 frames %.3f m/s\n", newest_change, five_frames);
+  EXPECT_LT(five_frames, 0.8 * newest_change);
+  EXPECT_LT(five_frames, 0.3);
+}

@@ -73,3 +73,21 @@ TEST(Config, PipelineConfigRejectsAMisspeltSection) {
   const std::string e = errorOf([&] { loadPipelineConfig(bad, c); });
   EXPECT_NE(e.find("trackr (line 2): unknown key"), std::string::npos) << e;
 }
+
+TEST(Config, TheDefaultConfigIsFoundFromAnyDirectory) {
+  namespace fs = std::filesystem;
+  const fs::path before = fs::current_path();
+  fs::current_path(fs::temp_directory_path());  // no config/ here
+  ::unsetenv("DLSLOT_CONFIG");
+  const std::string found = findConfigFile();
+  EXPECT_TRUE(fs::is_regular_file(found)) << found;
+  EXPECT_EQ(fs::path(found).filename(), "dlslot.yaml");
+  // $DLSLOT_CONFIG wins for the default; an explicit path is used as given.
+  const std::string mine = writeYaml("cfg_env.yaml", "channels: {}\n");
+  ::setenv("DLSLOT_CONFIG", mine.c_str(), 1);
+  EXPECT_EQ(findConfigFile(), mine);
+  EXPECT_EQ(findConfigFile("elsewhere/x.yaml"), "elsewhere/x.yaml");
+  ::unsetenv("DLSLOT_CONFIG");
+  EXPECT_NE(errorOf([] { loadConfig("/nonexistent/dlslot.yaml"); }).find("/nonexistent/dlslot.yaml"), std::string::npos);
+  fs::current_path(before);
+}

@@ -245,3 +245,28 @@ TEST(KittiRealData, LabelledCarsContainScanPoints) {
   }
   EXPECT_GT(cars, 20);
 }
+
+TEST(KittiSequence, DetectionOnlySequencesHaveFramesFromLabelsAndDetections) {
+  // The MOT setting: labels, calib and detections, no velodyne/.
+  const fs::path root = fs::temp_directory_path() / "dlslot_kitti_test" / "mot_root";
+  fs::remove_all(root);
+  fs::create_directories(root / "training" / "label_02");
+  fs::create_directories(root / "training" / "calib");
+  std::ofstream(root / "training" / "calib" / "0003.txt") << kCalibTracking;
+  std::ofstream(root / "training" / "label_02" / "0003.txt")
+      << "0 0 Car 0 0 -1.5 100 150 200 250 1.5 1.6 4.0 2.0 1.6 20.0 -1.57\n"
+      << "4 0 Car 0 0 -1.5 100 150 200 250 1.5 1.6 4.0 2.0 1.6 19.0 -1.57\n";
+  const std::string dets = tmpFile("mot_dets.txt", "0,2,100,150,200,250,5.0,1.5,1.6,4.0,2.0,1.6,20.0,-1.57,-1.5\n"
+                                                   "6,2,100,150,200,250,3.0,1.5,1.6,4.0,2.0,1.6,18.0,-1.57,-1.5\n");
+  const SequenceReader reader(root.string(), "0003", {dets});
+  EXPECT_FALSE(reader.hasScans());
+  EXPECT_EQ(reader.size(), 7);  // the detections reach frame 6
+  const Frame f = reader.read(6);
+  EXPECT_EQ(f.scan.cols(), 0);
+  ASSERT_EQ(f.detections.size(), 1u);
+  EXPECT_NEAR(f.detections[0].center.x(), 18.27, 1e-9);  // z_cam 18 + 0.27 (Tr_velo_cam)
+  EXPECT_EQ(reader.read(4).labels.size(), 1u);
+  // Without labels, detections or scans there is nothing to count frames from.
+  fs::remove(root / "training" / "label_02" / "0003.txt");
+  expectInputError([&] { SequenceReader(root.string(), "0003"); }, {"0003", "no scans", "no labels"});
+}

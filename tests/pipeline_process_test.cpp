@@ -28,7 +28,10 @@ constexpr int kFrames = 30;
 const std::string& simulatedRoot() {
   static const std::string root = [] {
     const std::string dir = binDir() + "/../test-scratch/pipeline-data";
-    if (!fs::exists(dir + "/training/poses/0000.txt")) {
+    // Simulated again when the simulator is newer than the cached sequence (its output may differ).
+    const bool stale = !fs::exists(dir + "/training/poses/0000.txt") ||
+                       fs::last_write_time(dir + "/training/poses/0000.txt") < fs::last_write_time(bin("dlslot-sim"));
+    if (stale) {
       fs::remove_all(dir);
       ChildProcess sim({bin("dlslot-sim"), "--scenario", "intersection", "--frames", std::to_string(kFrames), "--seed",
                         "3", "--out", dir},

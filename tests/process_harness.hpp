@@ -20,6 +20,8 @@
 #include <thread>
 #include <vector>
 
+#include "dlslot/message_guard.hpp"
+
 namespace dlslot::test {
 
 inline std::string sourceDir() { return DLSLOT_SOURCE_DIR; }
@@ -128,12 +130,13 @@ inline std::map<std::string, std::vector<std::vector<uint8_t>>> readLog(const st
   return out;
 }
 
+// The messages that pass the guard (message_guard.hpp); refused ones are left out.
 template <class Msg>
 std::vector<Msg> decodeAll(const std::vector<std::vector<uint8_t>>& raw) {
   std::vector<Msg> out;
   for (const auto& r : raw) {
     Msg m;
-    if (m.decode(r.data(), 0, r.size()) >= 0) out.push_back(m);
+    if (!decodeChecked(r.data(), r.size(), &m)) out.push_back(m);
   }
   return out;
 }

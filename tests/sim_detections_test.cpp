@@ -55,8 +55,7 @@ TEST(SimDetections, FoundByPointsNoisyAsConfiguredFalsePositivesScoredLower) {
     std::map<int, const kitti::LabelRow*> by_id;
     for (const auto& r : fd.detections) {
       ASSERT_TRUE(r.score);
-      EXPECT_GT(*r.score, 0.0);
-      EXPECT_LT(*r.score, 1.0);
+      EXPECT_TRUE(std::isfinite(*r.score));  // a raw logit, as PointRCNN writes it
       EXPECT_EQ(r.occluded, -1);
       if (r.track_id < 0) {
         ++fp;
@@ -96,5 +95,5 @@ TEST(SimDetections, FoundByPointsNoisyAsConfiguredFalsePositivesScoredLower) {
   ASSERT_GT(tp, 50);
   ASSERT_GT(fp, 3);
   EXPECT_NEAR(std::sqrt(err2 / tp), 1.0, 0.3);  // position errors have the configured sigma
-  EXPECT_GT(tp_score / tp, fp_score / fp + 0.2);
+  EXPECT_GT(tp_score / tp, fp_score / fp + 2.0);  // logits: true positives several units higher
 }

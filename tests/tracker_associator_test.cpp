@@ -277,9 +277,10 @@ TEST(TrackerAssociator, ClassesMustBeCompatible) {
   EXPECT_EQ(r.associations[0].track_id, 0);
 }
 
-TEST(TrackerAssociator, GateIsBinaryOnSquaredDistance) {
+TEST(TrackerAssociator, GateIsBinaryOnDistance) {
   AssociatorConfig cfg;
-  cfg.gate_sq_m2 = 4.0;
+  cfg.classes[0].young_gate_m = 2.0;  // car; a young trajectory's gate is a circle
+  cfg.classes[0].gate_growth_mps = 0.0;
   TrajectoryAssociator a(cfg);
   associateWorld(a, 0, {makeBox({0, 0}, "Car")});
   EXPECT_EQ(associateWorld(a, 1, {makeBox({1.99, 0}, "Car")}).associations[0].track_id, 0);
@@ -314,7 +315,7 @@ TEST(TrackerAssociator, InitializedTrajectoryIsPreferredOverAYoungOne) {
 
 TEST(TrackerAssociator, TrajectoriesEndAfterMaxMissedFrames) {
   AssociatorConfig cfg;
-  cfg.max_missed_frames = 3;
+  cfg.classes[0].max_misses = 3;
   TrajectoryAssociator a(cfg);
   for (int f = 0; f < 5; ++f) associateWorld(a, f, {makeBox({0, 0}, "Car")});
   for (int f = 5; f < 8; ++f) EXPECT_EQ(associateWorld(a, f, {}).num_active_tracks, 1);  // unseen 3 frames
@@ -359,10 +360,16 @@ TEST(TrackerAssociator, PreliminaryStaticOrDynamic) {
 
 TEST(TrackerAssociator, ConfigIsValidated) {
   AssociatorConfig c;
-  c.max_missed_frames = c.window_frames;
+  c.classes[0].max_misses = c.window_frames;
   EXPECT_THROW(TrajectoryAssociator{c}, std::invalid_argument);
   c = AssociatorConfig{};
-  c.gate_sq_m2 = 0;
+  c.classes[1].gate_across_m = 0;
+  EXPECT_THROW(TrajectoryAssociator{c}, std::invalid_argument);
+  c = AssociatorConfig{};
+  c.classes[2].types.push_back("Van");  // already a car
+  EXPECT_THROW(TrajectoryAssociator{c}, std::invalid_argument);
+  c = AssociatorConfig{};
+  c.classes[0].min_hits = c.window_frames + 1;
   EXPECT_THROW(TrajectoryAssociator{c}, std::invalid_argument);
   EXPECT_EQ(predictorFromName("last_position"), Predictor::LastPosition);
   EXPECT_THROW(predictorFromName("kalman"), std::invalid_argument);

@@ -87,6 +87,7 @@ TEST(TrackerProcess, LockstepFramesWithFaults) {
       car.center = X.inverse() * carWorld(f);
       car.size << 4.2, 1.8, 1.5;
       car.type = "Car";
+      car.score = 8.0;  // a confident detector's logit, above the car's min_score
       if (f == 3) {  // two malformed boxes before the car
         box_t bad = toMsg(car);
         bad.center[1] = nan;

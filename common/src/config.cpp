@@ -1,6 +1,9 @@
 #include "dlslot/config.hpp"
 
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <iostream>
 
 namespace dlslot {
 namespace {
@@ -65,6 +68,13 @@ ConfigSection ConfigSection::section(const std::string& key) {
   return ConfigSection(n, file_, path_.empty() ? key : path_ + "." + key);
 }
 
+std::vector<std::string> ConfigSection::keys() const {
+  std::vector<std::string> out;
+  if (node_.IsMap())
+    for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+  return out;
+}
+
 void ConfigSection::skip(const std::string& key) { read_->insert(key); }
 
 void ConfigSection::finish() const {
@@ -77,7 +87,31 @@ void ConfigSection::finish() const {
   }
 }
 
-ConfigSection loadConfig(const std::string& file) {
+std::string findConfigFile(const std::string& given) {
+  namespace fs = std::filesystem;
+  if (given != kDefaultConfig) return given;
+  if (const char* env = std::getenv("DLSLOT_CONFIG"); env && *env) return env;
+  std::vector<fs::path> candidates = {fs::path(given)};
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) candidates.push_back(exe.parent_path().parent_path() / "share" / "dlslot" / given);
+#ifdef DLSLOT_SOURCE_DIR
+  candidates.push_back(fs::path(DLSLOT_SOURCE_DIR) / given);
+#endif
+  std::string looked;
+  for (const fs::path& c : candidates) {
+    if (fs::is_regular_file(c, ec)) return c.lexically_normal().string();
+    looked += "\n  " + fs::absolute(c, ec).lexically_normal().string();
+  }
+  throw ConfigError(std::string(given) + ": no config file found (give --config FILE or set DLSLOT_CONFIG); looked at:" +
+                    looked);
+}
+
+ConfigSection loadConfig(const std::string& given) {
+  const std::string file = findConfigFile(given);
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) throw ConfigError(file + ": is a directory, expected a config file");
+  std::cerr << "config: " << std::filesystem::absolute(file, ec).lexically_normal().string() << "\n";
   std::ifstream in(file);
   if (!in) throw ConfigError(file + ": cannot open config file");
   try {

@@ -93,7 +93,7 @@ std::vector<int> solveAssignment(const Eigen::MatrixXd& cost) {
   return col_of_row;
 }
 
-std::vector<int> solveGatedAssignment(const Eigen::MatrixXd& cost, const Admissible& admissible) {
+std::vector<int> solveGatedAssignment(const Eigen::MatrixXd& cost, const Admissible& admissible, Objective objective) {
   if (cost.rows() != admissible.rows() || cost.cols() != admissible.cols())
     throw std::invalid_argument("solveGatedAssignment: cost and admissible differ in size");
   const int U = static_cast<int>(cost.rows()), V = static_cast<int>(cost.cols());
@@ -111,8 +111,22 @@ std::vector<int> solveGatedAssignment(const Eigen::MatrixXd& cost, const Admissi
     const std::vector<int>& rows = rows_of[root];
     const std::vector<int>& cols = cols_of[root];
     if (rows.empty() || cols.empty()) continue;
+    const bool least_cost = objective == Objective::LeastCost;
     if (rows.size() == 1 && cols.size() == 1) {  // the common case: one trajectory, one detection
-      col_of_row[rows[0]] = cols[0];
+      if (!least_cost || cost(rows[0], cols[0]) < 0) col_of_row[rows[0]] = cols[0];
+      continue;
+    }
+    if (least_cost) {
+      // A pair costing >= 0, or not admissible, is worth no more than leaving both unmatched
+      // (cost 0): with every entry <= 0 a full assignment's cost is that of its gainful pairs.
+      Eigen::MatrixXd c(rows.size(), cols.size());
+      for (size_t i = 0; i < rows.size(); ++i)
+        for (size_t j = 0; j < cols.size(); ++j)
+          c(i, j) = admissible(rows[i], cols[j]) ? std::min(cost(rows[i], cols[j]), 0.0) : 0.0;
+      const std::vector<int> a = solveAssignment(c);
+      for (size_t i = 0; i < rows.size(); ++i)
+        if (a[i] >= 0 && admissible(rows[i], cols[a[i]]) && cost(rows[i], cols[a[i]]) < 0)
+          col_of_row[rows[i]] = cols[a[i]];
       continue;
     }
     // Shift the admissible costs to >= 0; an inadmissible pair then costs more than any set of

@@ -1,12 +1,15 @@
 #include "dlslot/kitti.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 
 #include "dlslot/input_error.hpp"
 
@@ -16,6 +19,8 @@ namespace dlslot::kitti {
 namespace {
 
 constexpr double kEarthRadius = 6378137.0;  // the KITTI devkit's Mercator radius
+constexpr int kMaxFrame = 999999;      // six-digit file names (000000.bin)
+constexpr int kMaxTrackId = 999999;    // far beyond any sequence; keeps ids exact in an int
 
 std::vector<std::string> splitWs(const std::string& line) {
   std::istringstream is(line);
@@ -49,19 +54,38 @@ double number(const std::string& tok, const std::string& file, int line, const s
   }
   if (used != tok.size() || tok.empty())
     throw InputError(file, line, field + ": expected a number, got '" + tok + "'");
+  if (!std::isfinite(v)) throw InputError(file, line, field + ": expected a finite number, got '" + tok + "'");
   return v;
 }
 
-int integer(const std::string& tok, const std::string& file, int line, const std::string& field) {
+// An integer within [lo, hi] (the default: any int; a double beyond it must not wrap).
+int integer(const std::string& tok, const std::string& file, int line, const std::string& field,
+            double lo = std::numeric_limits<int>::min(), double hi = std::numeric_limits<int>::max()) {
   const double v = number(tok, file, line, field);
   if (v != std::floor(v)) throw InputError(file, line, field + ": expected an integer, got '" + tok + "'");
+  if (v < lo || v > hi)
+    throw InputError(file, line, field + ": expected an integer in " + std::to_string(static_cast<int64_t>(lo)) + ".." +
+                                     std::to_string(static_cast<int64_t>(hi)) + ", got '" + tok + "'");
   return static_cast<int>(v);
 }
 
+// A path that exists and is a regular file (a directory opens as a stream on Linux and reads as
+// garbage or fails with no file name).
+void requireFile(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw InputError(path, 0, "is a directory, expected a file");
+}
+
 std::ifstream openText(const std::string& path) {
+  requireFile(path);
   std::ifstream in(path);
   if (!in) throw InputError(path, 0, "cannot open file");
   return in;
+}
+
+// Box sizes in metres: finite (number() saw to that) and positive.
+void requirePositive(double v, const std::string& file, int line, const std::string& field) {
+  if (!(v > 0)) throw InputError(file, line, field + ": expected a size > 0 m, got " + std::to_string(v));
 }
 
 Pose rowsToPose(const std::vector<double>& v) {  // 12 numbers, 3x4 row-major
@@ -158,6 +182,7 @@ void writeCalib(const std::string& path, const Calib& calib) {
 // ---------------- velodyne ----------------
 
 PointCloud readVelodyne(const std::string& path) {
+  requireFile(path);
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw InputError(path, 0, "cannot open velodyne scan");
   const std::streamsize bytes = in.tellg();
@@ -216,9 +241,8 @@ std::vector<LabelRow> readTrackingLabels(const std::string& path) {
       throw InputError(path, n, "expected 17 fields (frame id type truncated occluded alpha x1 y1 x2 y2 h w l x y z "
                                 "rotation_y) or 18 (+ score), got " + std::to_string(t.size()));
     LabelRow r;
-    r.frame = integer(t[0], path, n, "frame");
-    if (r.frame < 0) throw InputError(path, n, "frame: expected >= 0, got " + t[0]);
-    r.track_id = integer(t[1], path, n, "track id");
+    r.frame = integer(t[0], path, n, "frame", 0, kMaxFrame);
+    r.track_id = integer(t[1], path, n, "track id", -1, kMaxTrackId);
     r.type = t[2];
     r.truncated = number(t[3], path, n, "truncated");
     r.occluded = integer(t[4], path, n, "occluded");
@@ -230,6 +254,11 @@ std::vector<LabelRow> readTrackingLabels(const std::string& path) {
     for (int i = 0; i < 3; ++i) r.box.bottom_center[i] = number(t[13 + i], path, n, "location");
     r.box.rotation_y = number(t[16], path, n, "rotation_y");
     if (t.size() == 18) r.score = number(t[17], path, n, "score");
+    if (r.type != "DontCare") {  // KITTI's DontCare rows carry -1 sizes: no 3D box
+      requirePositive(r.box.h, path, n, "h");
+      requirePositive(r.box.w, path, n, "w");
+      requirePositive(r.box.l, path, n, "l");
+    }
     rows.push_back(r);
   }
   return rows;
@@ -248,6 +277,74 @@ void writeTrackingLabels(const std::string& path, const std::vector<LabelRow>& r
   std::fclose(f);
 }
 
+// ---------------- results rows: the box in the image ----------------
+
+double observationAngle(const CameraBox& box) {
+  return wrapAngle(box.rotation_y - std::atan2(box.bottom_center.x(), box.bottom_center.z()));
+}
+
+std::optional<ImageBox> projectToImage(const CameraBox& box, const Calib& calib, const ImageSize& image) {
+  const Calib::Projection& P2 = calib.P[2];
+  if (P2.isZero()) throw std::invalid_argument("the calibration has no P2: boxes cannot be projected into image_02");
+  // Corners as the devkit builds them: length along x, width along z, height up (-y) from the
+  // bottom centre, rotated by rotation_y about the camera's y axis.
+  const double c = std::cos(box.rotation_y), s = std::sin(box.rotation_y);
+  Eigen::Matrix3d Ry;
+  Ry << c, 0, s, 0, 1, 0, -s, 0, c;
+  std::array<Eigen::Vector3d, 8> corners;
+  for (int i = 0; i < 8; ++i)
+    corners[i] = box.bottom_center + Ry * Eigen::Vector3d((i & 1 ? 0.5 : -0.5) * box.l, i & 2 ? -box.h : 0.0,
+                                                          (i & 4 ? 0.5 : -0.5) * box.w);
+  // Depth along camera 2's axis is the third row of P2; cut every edge at the near plane.
+  constexpr double kNear = 0.1;
+  const auto depth = [&](const Eigen::Vector3d& p) { return P2.row(2).dot(p.homogeneous()); };
+  std::vector<Eigen::Vector3d> visible;
+  for (int i = 0; i < 8; ++i) {
+    const double di = depth(corners[i]);
+    if (di >= kNear) visible.push_back(corners[i]);
+    for (int bit : {1, 2, 4}) {
+      const int j = i | bit;
+      if (j == i) continue;
+      const double dj = depth(corners[j]);
+      if ((di - kNear) * (dj - kNear) < 0) visible.push_back(corners[i] + (kNear - di) / (dj - di) * (corners[j] - corners[i]));
+    }
+  }
+  if (visible.empty()) return std::nullopt;
+  Eigen::Vector2d lo(INFINITY, INFINITY), hi(-INFINITY, -INFINITY);
+  for (const Eigen::Vector3d& p : visible) {
+    const Eigen::Vector3d uvw = P2 * p.homogeneous();
+    const Eigen::Vector2d uv = uvw.head<2>() / uvw.z();
+    lo = lo.cwiseMin(uv);
+    hi = hi.cwiseMax(uv);
+  }
+  ImageBox out;
+  out.unclipped << lo.x(), lo.y(), hi.x(), hi.y();
+  const double xmax = image.width - 1, ymax = image.height - 1;
+  out.bbox2d << std::clamp(lo.x(), 0.0, xmax), std::clamp(lo.y(), 0.0, ymax), std::clamp(hi.x(), 0.0, xmax),
+      std::clamp(hi.y(), 0.0, ymax);
+  if (!(out.bbox2d[2] > out.bbox2d[0] && out.bbox2d[3] > out.bbox2d[1])) return std::nullopt;  // outside the image
+  out.alpha = observationAngle(box);
+  return out;
+}
+
+std::optional<LabelRow> resultRow(LabelRow row, const Calib& calib, const ImageSize& image) {
+  const std::optional<ImageBox> ib = projectToImage(row.box, calib, image);
+  if (!ib) return std::nullopt;
+  row.bbox2d = ib->bbox2d;
+  row.alpha = ib->alpha;
+  return row;
+}
+
+std::optional<LabelRow> resultRow(int frame, const Box& box_lidar, const Calib& calib, const ImageSize& image) {
+  LabelRow row;
+  row.frame = frame;
+  row.track_id = box_lidar.id;
+  row.type = box_lidar.type;
+  row.box = lidarToCamera(box_lidar, calib);
+  row.score = box_lidar.score;
+  return resultRow(std::move(row), calib, image);
+}
+
 std::vector<LabelRow> readCsvDetections(const std::string& path) {
   std::ifstream in = openText(path);
   std::vector<LabelRow> rows;
@@ -259,8 +356,7 @@ std::vector<LabelRow> readCsvDetections(const std::string& path) {
       throw InputError(path, n, "expected 15 comma-separated fields (frame,type,x1,y1,x2,y2,score,h,w,l,x,y,z,rot_y,"
                                 "alpha), got " + std::to_string(t.size()));
     LabelRow r;
-    r.frame = integer(t[0], path, n, "frame");
-    if (r.frame < 0) throw InputError(path, n, "frame: expected >= 0, got " + t[0]);
+    r.frame = integer(t[0], path, n, "frame", 0, kMaxFrame);
     const int type = integer(t[1], path, n, "type");
     static const std::map<int, std::string> kTypes = {{1, "Pedestrian"}, {2, "Car"}, {3, "Cyclist"}};
     auto it = kTypes.find(type);
@@ -274,6 +370,9 @@ std::vector<LabelRow> readCsvDetections(const std::string& path) {
     for (int i = 0; i < 3; ++i) r.box.bottom_center[i] = number(t[10 + i], path, n, "location");
     r.box.rotation_y = number(t[13], path, n, "rot_y");
     r.alpha = number(t[14], path, n, "alpha");
+    requirePositive(r.box.h, path, n, "h");
+    requirePositive(r.box.w, path, n, "w");
+    requirePositive(r.box.l, path, n, "l");
     rows.push_back(r);
   }
   return rows;
@@ -390,7 +489,12 @@ std::vector<Pose> readPoses(const std::string& path) {
       throw InputError(path, n, "expected 12 numbers (a 3x4 row-major pose), got " + std::to_string(t.size()));
     std::vector<double> v;
     for (const auto& s : t) v.push_back(number(s, path, n, "pose"));
-    poses.push_back(rowsToPose(v));
+    const Pose T = rowsToPose(v);
+    const double off = (T.linear().transpose() * T.linear() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    if (off > 1e-3 || T.linear().determinant() < 0)
+      throw InputError(path, n, "pose: expected a rotation in the 3x3 block (R^T R = I, det 1), off by " +
+                                    std::to_string(off));
+    poses.push_back(T);
   }
   return poses;
 }
@@ -427,9 +531,14 @@ SequencePaths locateSequence(const std::string& root, const std::string& sequenc
   fs::path tracking = fs::path(root) / "training";
   if (!fs::is_directory(tracking / "velodyne") && fs::is_directory(fs::path(root) / "velodyne")) tracking = root;
   const fs::path odometry = fs::path(root) / "sequences" / sequence;
-  if (fs::is_directory(tracking / "velodyne" / sequence)) {
+  const bool tracking_scans = fs::is_directory(tracking / "velodyne" / sequence);
+  // A tracking sequence without scans (labels, calib and detections: the usual MOT setting).
+  const bool tracking_no_scans = !tracking_scans && !fs::is_directory(odometry / "velodyne") &&
+                                 (fs::exists(tracking / "label_02" / (sequence + ".txt")) ||
+                                  fs::exists(tracking / "calib" / (sequence + ".txt")));
+  if (tracking_scans || tracking_no_scans) {
     p.layout = SequencePaths::Layout::Tracking;
-    p.velodyne_dir = (tracking / "velodyne" / sequence).string();
+    if (tracking_scans) p.velodyne_dir = (tracking / "velodyne" / sequence).string();
     p.calib = (tracking / "calib" / (sequence + ".txt")).string();
     p.labels = ifExists(tracking / "label_02" / (sequence + ".txt"));
     p.oxts = ifExists(tracking / "oxts" / (sequence + ".txt"));
@@ -447,6 +556,7 @@ SequencePaths locateSequence(const std::string& root, const std::string& sequenc
                                   " (KITTI tracking) or " + (odometry / "velodyne").string() + " (KITTI odometry)");
   }
   if (!fs::exists(p.calib)) throw InputError(p.calib, 0, "calibration file missing");
+  if (p.velodyne_dir.empty()) return p;  // no scans: SequenceReader counts frames from labels and detections
   int n = 0;
   for (const auto& e : fs::directory_iterator(p.velodyne_dir))
     if (e.path().extension() == ".bin") ++n;
@@ -477,6 +587,28 @@ SequenceReader::SequenceReader(const std::string& root, const std::string& seque
                                const std::vector<std::string>& detection_paths, double min_detection_score,
                                double frame_period_s)
     : paths_(locateSequence(root, sequence)), calib_(readCalib(paths_.calib)), frame_period_s_(frame_period_s) {
+  const std::vector<LabelRow> label_rows = paths_.labels.empty() ? std::vector<LabelRow>() : readTrackingLabels(paths_.labels);
+  std::vector<std::vector<LabelRow>> detection_rows;
+  for (std::string path : detection_paths) {
+    if (fs::is_directory(path)) path = (fs::path(path) / (sequence + ".txt")).string();
+    std::ifstream in = openText(path);
+    std::string first;
+    while (std::getline(in, first) && first.find_first_not_of(" \t\r") == std::string::npos) {
+    }
+    const bool csv = first.find(',') != std::string::npos;
+    detection_rows.push_back(csv ? readCsvDetections(path) : readTrackingLabels(path));
+  }
+  if (!hasScans()) {
+    // Without scans the sequence is as long as its labels and detections say.
+    int last = -1;
+    for (const LabelRow& r : label_rows) last = std::max(last, r.frame);
+    for (const auto& rows : detection_rows)
+      for (const LabelRow& r : rows) last = std::max(last, r.frame);
+    if (last < 0)
+      throw InputError(paths_.labels.empty() ? paths_.calib : paths_.labels, 0,
+                       "sequence " + sequence + " has no scans (no velodyne/), no labels and no detections: nothing to read");
+    paths_.num_frames = last + 1;
+  }
   const int n = paths_.num_frames;
   // Ground-truth ego poses: a poses file wins over oxts.
   if (!paths_.poses.empty()) {
@@ -494,21 +626,14 @@ SequenceReader::SequenceReader(const std::string& root, const std::string& seque
   if (!gt_poses_.empty() && static_cast<int>(gt_poses_.size()) < n)
     throw InputError(!paths_.poses.empty() ? paths_.poses : paths_.oxts, 0,
                      "has " + std::to_string(gt_poses_.size()) + " poses, expected one per scan (" + std::to_string(n) + ")");
-  if (!paths_.labels.empty()) labels_ = boxesByFrame(readTrackingLabels(paths_.labels), calib_, n);
+  if (!paths_.labels.empty()) labels_ = boxesByFrame(label_rows, calib_, n);
   if (!paths_.times.empty()) {
     times_ = readTimes(paths_.times);
     if (static_cast<int>(times_.size()) < n)
       throw InputError(paths_.times, 0, "has " + std::to_string(times_.size()) + " times, expected " + std::to_string(n));
   }
   if (!detection_paths.empty()) detections_.assign(n, {});
-  for (std::string path : detection_paths) {
-    if (fs::is_directory(path)) path = (fs::path(path) / (sequence + ".txt")).string();
-    std::ifstream in = openText(path);
-    std::string first;
-    while (std::getline(in, first) && first.find_first_not_of(" \t\r") == std::string::npos) {
-    }
-    const bool csv = first.find(',') != std::string::npos;
-    const auto rows = csv ? readCsvDetections(path) : readTrackingLabels(path);
+  for (const auto& rows : detection_rows) {
     const auto frames = boxesByFrame(rows, calib_, n, min_detection_score);
     for (int i = 0; i < n; ++i)
       detections_[i].boxes.insert(detections_[i].boxes.end(), frames[i].boxes.begin(), frames[i].boxes.end());
@@ -527,7 +652,7 @@ Frame SequenceReader::read(int index) const {
   f.utime = static_cast<int64_t>(std::llround(t * 1e6));
   char name[32];
   std::snprintf(name, sizeof name, "%06d.bin", index);
-  f.scan = readVelodyne((fs::path(paths_.velodyne_dir) / name).string());
+  if (hasScans()) f.scan = readVelodyne((fs::path(paths_.velodyne_dir) / name).string());
   if (!detections_.empty()) f.detections = detections_[index].boxes;
   if (!labels_.empty()) {
     f.labels = labels_[index].boxes;

@@ -8,6 +8,7 @@
 #include <csignal>
 #include <cstdio>
 #include <iostream>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -115,8 +116,30 @@ void ProcessStatus::decodeError(const std::string& channel) {
   warn("could not decode a message on " + channel + " (skipped)");
 }
 
+void ProcessStatus::refused(const std::string& channel, const Refusal& why, const std::string& where) {
+  static const std::set<std::string> malformed = {"fingerprint", "truncated", "bad_count", "bad_string",
+                                                  "trailing_bytes", "decode", "decode_exception"};
+  if (malformed.count(why.reason))
+    ++decode_errors_;
+  else
+    ++errors_;
+  const std::string key = "refused." + channel + "." + why.reason;
+  if (counters_[key]++ == 0)
+    warn(where + channel + ": refused a message (" + why.reason + ": " + why.detail + "); more of this kind are only counted");
+  else
+    last_warning_ = channel + ": refused a message (" + why.reason + ")";
+}
+
+std::map<std::string, int64_t> ProcessStatus::refusals() const {
+  std::map<std::string, int64_t> out;
+  const std::string prefix = "refused.";
+  for (const auto& [k, v] : counters_)
+    if (k.rfind(prefix, 0) == 0) out[k.substr(prefix.size())] = v;
+  return out;
+}
+
 void ProcessStatus::frameGap(const std::string& channel, int expected, int got) {
-  gaps_ += got - expected;
+  gaps_ += static_cast<int64_t>(got) - expected;
   warn(channel + ": frame gap, expected frame " + std::to_string(expected) + ", got " + std::to_string(got));
 }
 

@@ -48,6 +48,10 @@ struct BackendConfig {
   // exceeds static_max_speed (m/s) and dynamic_min_sigmas standard deviations of that speed
   // (which box noise alone would cause); else it starts as a static landmark.
   double static_max_speed = 1.0;
+  // A dynamic object's reported velocity: its optimized chain's displacement over the last this
+  // many frames (eq. 10-11's pose changes summed), not the newest pose change alone, which the
+  // window constrains from one side only and which carries one frame's box noise.
+  int velocity_frames = 5;
   double dynamic_min_sigmas = 2.0;
   // A landmark turns dynamic when its last `switch_frames` observations each lie farther than
   // `switch_distance` (m, bird's-eye) from it (a parked car pulls out).

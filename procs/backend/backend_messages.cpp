@@ -25,6 +25,8 @@ std::vector<ObservationInput> observationsFromMsg(const associations_t& m, int* 
     o.initialized = a.initialized;
     o.box = dlslot::fromMsg(a.box_lidar);
     o.dynamic_guess = a.is_dynamic;
+    o.confirmed = a.status != association_t::STATUS_TENTATIVE;
+    o.confidence = a.confidence;
     out.push_back(o);
   }
   return out;
@@ -58,7 +60,7 @@ slot_state_t toMsg(const BackendOutput& out, const std::string& mode) {
     t.age = e.age;
     t.num_observations = e.num_observations;
     t.last_seen_frame = e.last_seen_frame;
-    t.status = e.status;
+    t.status = static_cast<int8_t>(e.status);
     t.confidence = e.confidence;
     m.tracks.push_back(t);
   }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "backend/se3.hpp"
+#include "dlslot/track_lifecycle.hpp"
 #include "dlslot/types.hpp"
 
 namespace dlslot::backend {
@@ -24,6 +25,8 @@ struct ObservationInput {
   bool initialized = false;   // the trajectory is in O_init (>= g observations)
   Box box;                    // b_t: lidar frame of this scan (centre, size l w h, yaw, type)
   bool dynamic_guess = false; // the tracker's preliminary static/dynamic guess
+  bool confirmed = true;      // the tracker's lifecycle confirmed the track (tentative ones stay out of the graph)
+  double confidence = 1.0;    // the track's confidence after this detection, [0, 1]
 };
 
 struct BackendInput {
@@ -46,8 +49,8 @@ struct TrackEstimate {
   int age = 0;               // frames since first seen
   int num_observations = 0;  // observations in the window
   int last_seen_frame = -1;
-  int8_t status = 1;         // track_t::STATUS_* (the tracker's lifecycle)
-  double confidence = 1.0;   // [0, 1], the tracker's lifecycle confidence
+  TrackStatus status = TrackStatus::Confirmed;  // confirmed when seen this frame, else coasting
+  double confidence = 1.0;   // [0, 1], the tracker's lifecycle confidence at its latest detection
 };
 
 struct SolveStats {

@@ -2,6 +2,7 @@
 // SLOT_STATE. Live over LCM, or offline from a recorded log (--offline IN --out OUT).
 #include <lcm/lcm-cpp.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -67,24 +68,31 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   lcm::LogFile in(in_path, "r");
   if (!in.good()) throw std::runtime_error(in_path + ": cannot open LCM log for reading");
   Joiner joiner(std::numeric_limits<double>::infinity());
-  int decode_errors = 0, rejected = 0;
-  while (const lcm::LogEvent* ev = in.readNextEvent()) {
+  // Every event goes through the guard (message_guard.hpp) as it would live; refused ones are
+  // skipped, counted by channel and reason, and their frames treated as missing.
+  ProcessStatus guard("backend");
+  std::map<std::string, FrameOrder> order;
+  std::map<int64_t, int> accepted;  // event index -> frame, for the copy below
+  int rejected = 0;
+  int64_t index = 0;
+  auto decode = [&](const lcm::LogEvent& ev, auto* msg) {
+    Refusal why = decodeChecked(ev.data, static_cast<size_t>(std::max(ev.datalen, 0)), msg);
+    if (!why) why = order[ev.channel].accept(msg->frame);
+    if (why) guard.refused(ev.channel, why, in_path + ": event " + std::to_string(index) + ": ");
+    else accepted[index] = msg->frame;
+    return !why;
+  };
+  for (; const lcm::LogEvent* ev = in.readNextEvent(); ++index) {
     if (ev->channel == channels.odometry) {
       odometry_t m;
-      if (m.decode(ev->data, 0, ev->datalen) < 0) {
-        ++decode_errors;
-        continue;
-      }
-      joiner.addA(m.frame, OdometryPart{m.utime, fromMsg(m)}, 0.0);
+      if (decode(*ev, &m)) joiner.addA(m.frame, OdometryPart{m.utime, fromMsg(m)}, 0.0);
     } else if (ev->channel == channels.associations) {
       associations_t m;
-      if (m.decode(ev->data, 0, ev->datalen) < 0) {
-        ++decode_errors;
-        continue;
-      }
-      joiner.addB(m.frame, AssociationsPart{m.utime, observationsFromMsg(m, &rejected)}, 0.0);
+      if (decode(*ev, &m)) joiner.addB(m.frame, AssociationsPart{m.utime, observationsFromMsg(m, &rejected)}, 0.0);
     }
   }
+  int64_t refused = 0;
+  for (const auto& [what, n] : guard.refusals()) refused += n;
   SlidingWindow window(config);
   TimingStats total, solve, marginalize;
   int frames = 0, missing_odometry = 0, missing_associations = 0;
@@ -115,17 +123,11 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
       copy.eventnum = n++;
       if (out.writeEvent(&copy) != 0) throw std::runtime_error(out_path + ": write failed");
     };
-    while (const lcm::LogEvent* ev = again.readNextEvent()) {
+    for (int64_t i = 0; const lcm::LogEvent* ev = again.readNextEvent(); ++i) {
       if (ev->channel == channels.slot_state) continue;
       write(*ev);
-      int frame = -1;
-      if (ev->channel == channels.odometry) {
-        odometry_t m;
-        if (m.decode(ev->data, 0, ev->datalen) >= 0) frame = m.frame;
-      } else if (ev->channel == channels.associations) {
-        associations_t m;
-        if (m.decode(ev->data, 0, ev->datalen) >= 0) frame = m.frame;
-      }
+      const auto input = accepted.find(i);
+      const int frame = input == accepted.end() ? -1 : input->second;
       auto left = inputs_left.find(frame);
       if (left == inputs_left.end() || --left->second > 0) continue;
       const slot_state_t& msg = states.at(frame);
@@ -139,8 +141,10 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
       write(state);
     }
   }
-  std::printf("backend (%s): %d frames, %d without odometry, %d without associations, %d undecodable, %d bad boxes\n",
-              toString(config.mode).c_str(), frames, missing_odometry, missing_associations, decode_errors, rejected);
+  std::printf("backend (%s): %d frames, %d without odometry, %d without associations, %lld refused events, %d bad boxes\n",
+              toString(config.mode).c_str(), frames, missing_odometry, missing_associations,
+              static_cast<long long>(refused), rejected);
+  for (const auto& [what, n] : guard.refusals()) std::printf("  refused %s: %lld\n", what.c_str(), static_cast<long long>(n));
   std::printf("  total %.2f ms mean, %.2f p95; solve %.2f mean; marginalize %.2f mean\n", total.mean(),
               total.percentile(95), solve.mean(), marginalize.mean());
   return 0;

@@ -138,8 +138,11 @@ void SlidingWindow::addObservations(const BackendInput& in) {
     track.size += (obs.box.size - track.size) / track.size_samples;
     track.last_seen = in.frame;
     track.dynamic_guess = obs.dynamic_guess;
+    track.confidence = obs.confidence;
     track.observations[in.frame] = Observation{alignedBox(track, X, obs.box), false};
-    if (!obs.initialized) continue;  // not in O_init yet: evidence only
+    // Not in O_init yet, or not confirmed by the tracker's lifecycle (a likely false positive):
+    // evidence only, never in the graph where it could pull the ego poses.
+    if (!obs.initialized || !obs.confirmed) continue;
     if (track.model == TrackModel::kNotInGraph) startTrack(track, in.frame);
     addTrackObservation(track, in.frame);
   }
@@ -300,6 +303,8 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
     e.dynamic = track.model == TrackModel::kDynamic;
     e.age = t - first_seen_.at(id);
     e.last_seen_frame = track.last_seen;
+    e.status = track.last_seen == t ? TrackStatus::Confirmed : TrackStatus::Coasting;
+    e.confidence = track.confidence;
     for (const auto& [f, obs] : track.observations) e.num_observations += obs.in_graph;
     const double* block = nullptr;
     if (!e.dynamic) {
@@ -314,16 +319,23 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
         // velocity of the trajectory's observed positions in the window says more.
         if (const auto fit = windowMotion(track)) e.velocity = fit->velocity;
       } else {
-        // Velocities from the latest pose change c_f^{f+1} = o_f^-1 o_{f+1} over its time.
+        // Angular velocity from the latest pose change c_f^{f+1} = o_f^-1 o_{f+1} over its time; the
+        // linear velocity from the chain's displacement over the last velocity_frames frames.
         const auto& [f, c_block] = *track.changes.rbegin();
         const EgoFrame *a = findFrame(f), *b = findFrame(f + 1);
         const double dt = a && b ? 1e-6 * static_cast<double>(b->utime - a->utime) : 0.0;
         if (dt > 0) {
           const Eigen::Matrix3d R_f = fromBlock(track.poses.at(f)->data()).linear();
           const Vector6 c = logPose(fromBlock(c_block->data()));
-          e.velocity = R_f * c.head<3>() / dt;
           e.angular_velocity = R_f * c.tail<3>() / dt;
         }
+        const auto last = track.poses.rbegin();
+        auto first = last;
+        for (int i = 0; i < config_.velocity_frames && std::next(first) != track.poses.rend(); ++i) ++first;
+        const EgoFrame *fa = findFrame(first->first), *fb = findFrame(last->first);
+        const double span = fa && fb ? 1e-6 * static_cast<double>(fb->utime - fa->utime) : 0.0;
+        if (span > 0)
+          e.velocity = (fromBlock(last->second->data()).translation() - fromBlock(first->second->data()).translation()) / span;
       }
     }
     if (block) e.covariance = covariance(block);

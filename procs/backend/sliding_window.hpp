@@ -64,6 +64,7 @@ class SlidingWindow {
     int size_samples = 0;
     int last_seen = -1;
     bool dynamic_guess = false;
+    double confidence = 1.0;  // the tracker's lifecycle confidence at the latest detection
     TrackModel model = TrackModel::kNotInGraph;
     Block landmark;                 // static: one pose for the whole window
     std::map<int, Block> poses;     // dynamic: frame -> o_frame

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <map>
 
+#include "dlslot/input_error.hpp"
 #include "dlslot/kitti.hpp"
 #include "dlslot/progress.hpp"
 #include "dlslot/timing_stats.hpp"
@@ -27,6 +28,9 @@ const char* statusName(Status s) {
 int runOffline(const OfflineOptions& opts, const OdometryConfig& cfg) {
   kitti::SequenceReader reader(opts.root, opts.sequence, opts.detections, opts.min_detection_score,
                                opts.frame_period_s);
+  if (!reader.hasScans())
+    throw InputError(opts.root, 0, "sequence " + opts.sequence + " has no scans (expected training/velodyne/" +
+                                       opts.sequence + "/): odometry needs them");
   if (cfg.remove_detected_objects && opts.detections.empty())
     std::fprintf(stderr, "dlslot-odometry: mode aloam-filtered without --detections: nothing is removed\n");
   LidarOdometry odometry(cfg);
@@ -35,6 +39,8 @@ int runOffline(const OfflineOptions& opts, const OdometryConfig& cfg) {
   std::map<std::string, TimingStats> stages;
   std::map<Status, int> statuses;
   long removed = 0, points = 0;
+  // Per-scan statistics of registered scans, to compare simulated scans with real ones (issue 15).
+  TimingStats edges, planes, residuals, correspondences;
   ProgressLine progress("odometry " + opts.sequence + " (" + modeName(cfg.remove_detected_objects) + ")",
                         reader.size());
   for (int i = 0; i < reader.size(); ++i) {
@@ -44,6 +50,12 @@ int runOffline(const OfflineOptions& opts, const OdometryConfig& cfg) {
     if (r.status == Status::FallbackFewPoints || r.status == Status::FallbackSolveFailed)
       std::fprintf(stderr, "\nframe %d: %s: %s\n", i, statusName(r.status), r.status_text.c_str());
     removed += r.num_points_removed;
+    if (r.status == Status::Ok) {
+      edges.add(r.num_edge);
+      planes.add(r.num_plane);
+      residuals.add(1000.0 * r.residual_mean);
+      correspondences.add(r.num_correspondences);
+    }
     points += r.num_points_in;
     for (const auto& [name, ms] : r.timings) {
       if (!stages.count(name)) stage_order.push_back(name);
@@ -62,6 +74,10 @@ int runOffline(const OfflineOptions& opts, const OdometryConfig& cfg) {
   for (const std::string& name : stage_order)
     std::printf("%-14s %9.2f %9.2f %9.2f\n", name.c_str(), stages[name].mean(), stages[name].percentile(95),
                 stages[name].max());
+  if (edges.count() > 0)
+    std::printf("per scan (%zu registered): edge features %.0f, plane features %.0f, scan-to-map correspondences "
+                "%.0f, residual mean %.2f mm\n",
+                edges.count(), edges.mean(), planes.mean(), correspondences.mean(), residuals.mean());
   if (!poses.empty()) {
     const Eigen::Vector3d p = poses.back().translation();
     std::printf("final position %.3f %.3f %.3f m\n", p.x(), p.y(), p.z());

@@ -7,6 +7,7 @@
 #include "dlslot/convert.hpp"
 #include "dlslot/detections_t.hpp"
 #include "dlslot/ground_truth_t.hpp"
+#include "dlslot/input_error.hpp"
 #include "dlslot/kitti.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/point_cloud_t.hpp"
@@ -58,19 +59,30 @@ int run(int argc, char** argv) {
   if (sequence.empty()) throw std::invalid_argument("--sequence SSSS is required");
 
   kitti::SequenceReader reader(root, sequence, detections, cfg.min_detection_score, cfg.frame_period_s);
+  if (!reader.hasScans())
+    throw InputError(root, 0, "sequence " + sequence + " has no scans (expected training/velodyne/" + sequence +
+                                  "/): the player needs them; for tracking on detections alone use dlslot-tracker "
+                                  "--kitti or ./dlslot track-eval");
   const player::FrameRange range = player::resolveRange({start, end}, reader.size());
 
   Node node("player", node_opts.lcm_url, channels);
   installSignalHandlers();
   node.every(1.0, [&] { node.publishStatus(); });
 
-  // Lockstep: remember the newest frame seen on the followed channel, whatever its type.
-  int acked_frame = -1;
+  // Lockstep: remember the newest frame seen on the followed channel, whatever its type. Only a
+  // frame this player has already published can acknowledge one (a stray frame 10^9 must not
+  // release every frame after it).
+  int acked_frame = -1, published_frame = -1;
   if (!lockstep.empty())
     node.subscribeRaw(lockstep, [&](const lcm::ReceiveBuffer& rbuf) {
       const int f = frameOfEncoded(rbuf.data, rbuf.data_size);
-      if (f < 0) node.status().decodeError(lockstep);
-      acked_frame = std::max(acked_frame, f);
+      if (f < 0)
+        node.status().refused(lockstep, {"truncated", "too short to hold a frame number"});
+      else if (f > published_frame)
+        node.status().refused(lockstep, {"frame_range", "frame " + std::to_string(f) + " not played yet (newest " +
+                                                            std::to_string(published_frame) + ")"});
+      else
+        acked_frame = std::max(acked_frame, f);
     });
 
   node.spinUntil([] { return false; }, delay_s);
@@ -115,6 +127,7 @@ int run(int argc, char** argv) {
       gt.num_dontcare = static_cast<int32_t>(gt.dontcare.size());
       node.publish(channels.ground_truth, gt);
     }
+    published_frame = frame.index;
     node.status().frameDone(frame.index, std::chrono::duration<double, std::milli>(Node::Clock::now() - tic).count());
     ++played;
 

@@ -63,6 +63,9 @@ void report(const FrameSink& sink, const std::string& out, const std::string& su
   if (sink.skipped()) std::cerr << ", " << sink.skipped() << " frames skipped (the writer was behind)";
   if (!summary.empty()) std::cerr << ", summary " << summary;
   if (s.decode_errors) std::cerr << ", " << s.decode_errors << " undecodable messages";
+  int64_t refused = 0;
+  for (const auto& [what, n] : status.refusals()) refused += n;
+  if (refused) std::cerr << ", " << refused << " refused messages";
   std::cerr << "\n";
 }
 

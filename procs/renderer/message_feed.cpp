@@ -1,5 +1,6 @@
 #include "message_feed.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "dlslot/convert.hpp"
@@ -129,16 +130,12 @@ template <class Msg>
 void MessageFeed::decodeAndFeed(const std::string& channel, const void* data, int size,
                                 void (MessageFeed::*feed)(const Msg&)) {
   Msg m;
-  bool ok = false;
-  try {
-    ok = m.decode(data, 0, size) >= 0;
-  } catch (const std::exception&) {
-    ok = false;  // absurd array lengths make the generated decoder allocate and throw
-  }
-  if (ok)
-    (this->*feed)(m);
+  Refusal why = decodeChecked(data, static_cast<size_t>(std::max(size, 0)), &m);
+  if (!why) why = order_[channel].accept(m.frame);
+  if (why)
+    status_.refused(channel, why);
   else
-    status_.decodeError(channel);
+    (this->*feed)(m);
 }
 
 void MessageFeed::handle(const std::string& channel, const void* data, int size) {

@@ -3,12 +3,14 @@
 // boxes) is counted in the process status and skipped, never drawn and never fatal.
 #pragma once
 
+#include <map>
 #include <string>
 
 #include "dlslot/associations_t.hpp"
 #include "dlslot/config.hpp"
 #include "dlslot/detections_t.hpp"
 #include "dlslot/ground_truth_t.hpp"
+#include "dlslot/message_guard.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/odometry_t.hpp"
 #include "dlslot/point_cloud_t.hpp"
@@ -28,7 +30,8 @@ class MessageFeed {
   void onAssociations(const associations_t& m);
   void onSlotState(const slot_state_t& m);
 
-  // Offline: decodes a logged event by its channel and feeds it; other channels are ignored.
+  // Offline: decodes a logged event by its channel through the guard (message_guard.hpp, with the
+  // same frame-order check as a live node) and feeds it; other channels are ignored.
   void handle(const std::string& channel, const void* data, int size);
 
  private:
@@ -41,6 +44,7 @@ class MessageFeed {
   RunState& state_;
   ProcessStatus& status_;
   Channels channels_;
+  std::map<std::string, FrameOrder> order_;  // offline only: live, the Node checks the order
 };
 
 }  // namespace dlslot::renderer

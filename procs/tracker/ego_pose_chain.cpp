@@ -42,10 +42,11 @@ EgoPose EgoPoseChain::poseAt(int frame) const {
 
   // T_f^{f+1} * ... * T_{t-1}^t from the deltas. A scan the odometry never saw (a frame gap)
   // leaves a hole: its own poses still give the motion, X_t = X_f * inv(O_f) * O_t.
+  // (64-bit loop counters: with frame == INT32_MAX an int counter would never pass it.)
   bool complete = true;
-  for (int f = from + 1; f <= frame && complete; ++f) complete = odometry_delta_.count(f) > 0;
+  for (int64_t f = int64_t{from} + 1; f <= frame && complete; ++f) complete = odometry_delta_.count(static_cast<int>(f)) > 0;
   if (complete) {
-    for (int f = from + 1; f <= frame; ++f) out.X = out.X * odometry_delta_.at(f);
+    for (int64_t f = int64_t{from} + 1; f <= frame; ++f) out.X = out.X * odometry_delta_.at(static_cast<int>(f));
     return out;
   }
   auto o_from = odometry_pose_.find(from), o_to = odometry_pose_.find(frame);
@@ -57,8 +58,8 @@ EgoPose EgoPoseChain::poseAt(int frame) const {
   out.source = PoseSource::Predicted;
   const Pose* last_delta = nullptr;
   if (auto before = odometry_delta_.find(from); before != odometry_delta_.end()) last_delta = &before->second;
-  for (int f = from + 1; f <= frame; ++f) {
-    if (auto d = odometry_delta_.find(f); d != odometry_delta_.end()) last_delta = &d->second;
+  for (int64_t f = int64_t{from} + 1; f <= frame; ++f) {
+    if (auto d = odometry_delta_.find(static_cast<int>(f)); d != odometry_delta_.end()) last_delta = &d->second;
     if (last_delta) out.X = out.X * *last_delta;  // with no motion known, standing still
   }
   return out;

@@ -17,37 +17,13 @@
 #include "dlslot/slot_state_t.hpp"
 #include "ego_pose_chain.hpp"
 #include "offline_run.hpp"
+#include "tracker_config.hpp"
 #include "trajectory_associator.hpp"
 
 using namespace dlslot;
 using namespace dlslot::tracker;
 
 namespace {
-
-struct TrackerConfig {
-  AssociatorConfig associator;
-  double join_timeout_s = 2.0;
-
-  void read(ConfigSection s) {
-    s.get("window_frames", associator.window_frames);
-    s.get("init_observations", associator.init_observations);
-    s.get("gate_sq_m2", associator.gate_sq_m2);
-    s.get("max_missed_frames", associator.max_missed_frames);
-    s.get("max_polynomial_degree", associator.max_polynomial_degree);
-    s.get("max_noise_gain", associator.max_noise_gain);
-    s.get("dynamic_displacement_m", associator.dynamic_displacement_m);
-    s.get("join_timeout_s", join_timeout_s);
-    const std::string predictor = s.get<std::string>("predictor");
-    s.finish();
-    try {
-      associator.predictor = predictorFromName(predictor);
-      associator.validate();
-      if (!(join_timeout_s > 0)) throw std::invalid_argument("join_timeout_s: expected > 0");
-    } catch (const std::invalid_argument& e) {
-      throw ConfigError(s.file() + ": " + s.path() + "." + e.what());
-    }
-  }
-};
 
 std::string seconds(double s) {
   char buf[32];
@@ -108,7 +84,7 @@ associations_t toMsg(const JoinedFrame& joined, const EgoPose& ego, const FrameA
     for (int k = 0; k < 3; ++k) out.predicted[k] = p[k];
     out.is_dynamic = a.is_dynamic;
     out.displacement = a.displacement;
-    out.status = a.status;
+    out.status = static_cast<int8_t>(a.status);
     out.confidence = a.confidence;
     m.associations.push_back(out);
   }
@@ -117,29 +93,31 @@ associations_t toMsg(const JoinedFrame& joined, const EgoPose& ego, const FrameA
 }
 
 struct OfflineOptions {
-  std::string kitti_root, sequence, poses, tracks_out;
+  std::string kitti_root, sequence, poses, tracks_out, output;
   std::vector<std::string> detections;
   double min_detection_score = -1e9, frame_period_s = 0.1;
-  bool initialized_only = false;
+  bool all_around = false;
 };
 
 // Associates a whole sequence from files and writes the tracks (no LCM).
-int runOffline(const OfflineOptions& o, const AssociatorConfig& config) {
+int runOffline(const OfflineOptions& o, TrackerConfig config) {
   if (o.sequence.empty()) throw std::invalid_argument("--sequence SSSS is required with --kitti");
   if (o.tracks_out.empty()) throw std::invalid_argument("--tracks-out FILE is required with --kitti");
+  if (!o.output.empty()) config.output = trackOutputFromName(o.output);
   const kitti::SequenceReader reader(o.kitti_root, o.sequence, o.detections, o.min_detection_score, o.frame_period_s);
-  std::vector<Pose> poses;
-  if (!o.poses.empty()) {
-    poses = kitti::readPoses(o.poses);
-  } else if (reader.hasGroundTruthPoses()) {
-    poses = reader.groundTruthPoses();
-  } else {
-    throw std::invalid_argument("no ego poses: the sequence has none; give --poses FILE (KITTI 3x4 lidar poses)");
-  }
-  const OfflineResult r = associateSequence(reader, poses, config, o.initialized_only);
+  if (!reader.hasScans()) std::fprintf(stderr, "sequence %s: no scans, %d frames from its labels and detections\n",
+                                       o.sequence.c_str(), reader.size());
+  std::string pose_source;
+  const std::vector<Pose> poses = egoPosesFor(reader, o.sequence, o.poses, &pose_source);
+  std::fprintf(stderr, "%s\n", pose_source.c_str());
+  const OfflineResult r = associateSequence(reader, poses, config.associator, config.output, o.all_around);
   kitti::writeTrackingLabels(o.tracks_out, r.tracks);
-  std::printf("%d frames, %d detections (%d initialized), %d trajectories; association %.3f ms mean, %.3f ms p95 a frame\n",
-              reader.size(), r.detections, r.initialized, r.trajectories, r.association_ms.mean(),
+  std::printf("%d frames, %d detections: %d associated (%d confirmed), %d not tracked (type %d, score %d, duplicate %d); "
+              "%d trajectories; %zu rows written (%s, %d outside the camera image%s); association %.3f ms mean, %.3f ms p95 a frame\n",
+              reader.size(), r.detections, r.associated, r.confirmed, r.skipped.total(), r.skipped.untracked_type,
+              r.skipped.below_score, r.skipped.duplicate, r.trajectories, r.tracks.size(),
+              config.output == TrackOutput::All ? "all tracks" : "confirmed tracks", r.outside_image,
+              o.all_around ? ", written too" : " left out", r.association_ms.mean(),
               r.association_ms.percentile(95));
   return 0;
 }
@@ -155,18 +133,22 @@ int run(int argc, char** argv) {
   cl.option("--kitti", &off.kitti_root, "offline: KITTI root (tracking or odometry layout)");
   cl.option("--sequence", &off.sequence, "offline: sequence name, e.g. 0000");
   cl.repeated("--detections", &off.detections, "offline: detection file or directory");
-  cl.option("--poses", &off.poses, "offline: ego poses, KITTI 3x4 lidar poses (default: the sequence's ground truth)");
+  cl.option("--poses", &off.poses,
+            "offline: ego poses, KITTI 3x4 lidar poses, a file or a directory of SSSS.txt (default: the sequence's "
+            "ground truth, else identity)");
   cl.option("--tracks-out", &off.tracks_out, "offline: output file, KITTI tracking result format");
   cl.option("--min-score", &off.min_detection_score, "offline: drop detections scoring below this (default -1e9)");
-  cl.flag("--initialized-only", &off.initialized_only, "offline: output only initialized associations (III-D)");
+  cl.option("--output", &off.output, "offline: confirmed | all (default: tracker.output of the config)");
+  cl.flag("--all-around", &off.all_around,
+          "offline: also write tracks outside the camera image (2-D box -1), for labels all around the scan "
+          "(simulated sequences); not for the KITTI devkit");
   if (!cl.parse(argc, argv)) return 0;
 
   Channels channels;
   ConfigSection root_cfg = loadPipelineConfig(node_opts.config, channels);
-  TrackerConfig cfg;
-  cfg.read(root_cfg.section("tracker"));
+  const TrackerConfig cfg = TrackerConfig::read(root_cfg.section("tracker"));
   if (node_opts.check_config) return 0;
-  if (!off.kitti_root.empty()) return runOffline(off, cfg.associator);
+  if (!off.kitti_root.empty()) return runOffline(off, cfg);
 
   Node node("tracker", node_opts.lcm_url, channels);
   ProcessStatus& status = node.status();
@@ -200,6 +182,10 @@ int run(int argc, char** argv) {
     }
     status.count("tracks_ended", result.num_ended_tracks);
     status.count("associations", static_cast<int64_t>(result.associations.size()));
+    // Detections not tracked, by reason (counted, never silently dropped).
+    status.count("detections_untracked_type", result.skipped.untracked_type);
+    status.count("detections_below_score", result.skipped.below_score);
+    status.count("detections_duplicate", result.skipped.duplicate);
 
     associations_t msg = toMsg(joined, ego, result);
     const double ms = std::chrono::duration<double, std::milli>(Node::Clock::now() - tic).count();

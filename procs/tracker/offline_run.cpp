@@ -1,36 +1,85 @@
 #include "offline_run.hpp"
 
 #include <chrono>
+#include <filesystem>
 #include <stdexcept>
+
+#include "dlslot/input_error.hpp"
 
 namespace dlslot::tracker {
 
+std::vector<Pose> egoPosesFor(const kitti::SequenceReader& reader, const std::string& sequence, const std::string& poses,
+                              std::string* source) {
+  namespace fs = std::filesystem;
+  std::vector<Pose> out;
+  if (!poses.empty()) {
+    const std::string file = fs::is_directory(poses) ? (fs::path(poses) / (sequence + ".txt")).string() : poses;
+    if (fs::exists(file)) {
+      out = kitti::readPoses(file);
+      if (static_cast<int>(out.size()) < reader.size())
+        throw InputError(file, 0, "has " + std::to_string(out.size()) + " poses, expected one per frame (" +
+                                      std::to_string(reader.size()) + ")");
+      *source = "ego poses from " + file;
+      return out;
+    }
+    if (!fs::is_directory(poses)) throw InputError(file, 0, "ego pose file missing");
+  }
+  if (reader.hasGroundTruthPoses()) {
+    *source = "ego poses from the sequence's ground truth";
+    return reader.groundTruthPoses();
+  }
+  *source = "no ego poses for sequence " + sequence + ": identity (tracking in the sensor frame)";
+  return std::vector<Pose>(reader.size(), Pose::Identity());
+}
+
 OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::vector<Pose>& ego_poses,
-                                const AssociatorConfig& config, bool initialized_only) {
+                                const AssociatorConfig& config, TrackOutput output, bool all_around) {
   if (static_cast<int>(ego_poses.size()) < reader.size())
     throw std::invalid_argument("ego poses: " + std::to_string(ego_poses.size()) + " for " +
                                 std::to_string(reader.size()) + " frames");
   TrajectoryAssociator associator(config);
   OfflineResult out;
+  auto write = [&](int frame, const Box& box) {
+    if (auto row = kitti::resultRow(frame, box, reader.calib())) {
+      out.tracks.push_back(*row);
+      return;
+    }
+    ++out.outside_image;
+    if (!all_around) return;
+    kitti::LabelRow row;
+    row.frame = frame;
+    row.track_id = box.id;
+    row.type = box.type;
+    row.alpha = -10;
+    row.bbox2d = Eigen::Vector4d::Constant(-1);
+    row.box = kitti::lidarToCamera(box, reader.calib());
+    row.score = box.score;
+    out.tracks.push_back(row);
+  };
   int max_id = -1;
   for (int i = 0; i < reader.size(); ++i) {
     const Frame frame = reader.read(i);
     const auto tic = std::chrono::steady_clock::now();
     const FrameAssociations r = associator.associate(frame.index, frame.utime * 1e-6, ego_poses[i], frame.detections);
     out.association_ms.add(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tic).count());
+    out.detections += static_cast<int>(frame.detections.size());
+    out.skipped.untracked_type += r.skipped.untracked_type;
+    out.skipped.below_score += r.skipped.below_score;
+    out.skipped.duplicate += r.skipped.duplicate;
     for (const Association& a : r.associations) {
-      ++out.detections;
-      out.initialized += a.initialized;
+      ++out.associated;
       max_id = std::max(max_id, a.track_id);
-      if (initialized_only && !a.initialized) continue;
-      kitti::LabelRow row;
-      row.frame = frame.index;
-      row.track_id = a.track_id;
-      row.type = a.box_lidar.type;
-      row.alpha = -10;  // the devkit's "unknown": no image observation angle from a 3D detector
-      row.box = kitti::lidarToCamera(a.box_lidar, reader.calib());
-      row.score = a.box_lidar.score;
-      out.tracks.push_back(row);
+      const bool confirmed = a.status == TrackStatus::Confirmed;
+      out.confirmed += confirmed;
+      if (output == TrackOutput::Confirmed && !confirmed) continue;
+      Box box = a.box_lidar;
+      box.id = a.track_id;
+      box.score = a.confidence;
+      write(frame.index, box);
+    }
+    for (const CoastingTrack& c : r.coasting) {
+      ++out.coasting;
+      write(frame.index, c.box_lidar);
     }
   }
   out.trajectories = max_id + 1;

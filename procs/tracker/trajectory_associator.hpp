@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "dlslot/track_lifecycle.hpp"
 #include "dlslot/types.hpp"
 #include "trajectory_predictor.hpp"
 
@@ -17,17 +18,24 @@ enum class Predictor {
 };
 Predictor predictorFromName(const std::string& name);  // "polynomial" | "last_position"
 
+// The default per-class policies (config/dlslot.yaml has the tuned ones): car = Car, Van,
+// Truck; pedestrian = Pedestrian, Person_sitting; cyclist = Cyclist.
+std::vector<ClassPolicy> defaultClassPolicies();
+
 struct AssociatorConfig {
   int window_frames = 10;             // k: observations of the last k frames are kept
   int init_observations = 3;          // g: observations needed to fit and be "initialized"
-  // theta of eq. 6, on the squared bird's-eye distance (eq. 7). A young trajectory predicts with
-  // its last position, so theta must exceed what a car moves in a frame (3 m at 30 m/s and 10 Hz).
-  double gate_sq_m2 = 16.0;
-  int max_missed_frames = 9;          // a trajectory unseen for more frames than this ends (< k)
   Predictor predictor = Predictor::Polynomial;
-  int max_polynomial_degree = 3;      // eq. 3 is a cubic
   double max_noise_gain = 3.0;        // lower the degree while the fit extrapolates noise more (predictPolynomial)
   double dynamic_displacement_m = 1.0;  // window displacement above which a trajectory is dynamic
+  ScoreScale score_scale = ScoreScale::Logit;  // how detection scores become confidences
+  // Two detections on one object (e.g. a Car and a Pedestrian box from two class files): the
+  // less confident one is dropped when its centre lies inside the other's footprint grown by
+  // this margin (bird's-eye view).
+  double duplicate_margin_m = 0.0;
+  // Per class: score threshold, gate (eq. 6, theta), hits to confirm, misses to end. Detections
+  // of a type no policy names are not tracked (counted in FrameAssociations).
+  std::vector<ClassPolicy> classes = defaultClassPolicies();
 
   void validate() const;  // std::invalid_argument naming the bad field
 };
@@ -35,11 +43,14 @@ struct AssociatorConfig {
 // A trajectory Tr^u: its observations o^u inside the window (oldest first) and its latest box.
 struct Trajectory {
   int id = -1;
-  Box last_box;  // world frame; type is the class the trajectory is gated with
+  Box last_box;  // world frame, the latest detection
   int last_frame = -1;
+  double last_time_s = 0.0;
   std::vector<TrajectoryPoint> window;
   double displacement = 0.0;
   bool is_dynamic = false;
+  int policy = -1;  // index into AssociatorConfig::classes: the class group it is gated with
+  TrackLifecycle lifecycle{0.0, ClassPolicy{}};
 };
 
 // The outcome for one detection of the frame.
@@ -54,12 +65,32 @@ struct Association {
   std::optional<Eigen::Vector3d> predicted;  // the trajectory's predicted position at this frame
   bool is_dynamic = false;
   double displacement = 0.0;
-  int8_t status = 1;          // association_t::STATUS_* of the trajectory after this detection
-  double confidence = 1.0;    // [0, 1], the trajectory's confidence after this detection
+  TrackStatus status = TrackStatus::Tentative;  // of the trajectory after this detection
+  double confidence = 0.0;    // [0, 1], the trajectory's confidence after this detection
+};
+
+// A confirmed trajectory the detector missed at this frame, reported at its prediction
+// (ClassPolicy::output_coasting_frames).
+struct CoastingTrack {
+  int track_id = -1;
+  int missed_frames = 0;  // frames since its last detection, this one included
+  Box box_world;          // its last box moved to the predicted position
+  Box box_lidar;          // the same in this scan's lidar frame
+  double confidence = 0.0;
+};
+
+// Detections that were not associated, and why (nothing is dropped silently).
+struct SkippedDetections {
+  int untracked_type = 0;  // no class policy names the type
+  int below_score = 0;     // under the class's min_score
+  int duplicate = 0;       // inside a more confident detection of the same frame
+  int total() const { return untracked_type + below_score + duplicate; }
 };
 
 struct FrameAssociations {
-  std::vector<Association> associations;  // one per detection, in detection order
+  std::vector<Association> associations;  // one per tracked detection, in detection order
+  SkippedDetections skipped;              // the detections without an association
+  std::vector<CoastingTrack> coasting;    // confirmed trajectories reported through a miss
   int num_active_tracks = 0;              // trajectories alive after this frame
   int num_ended_tracks = 0;               // trajectories that ended at this frame
 };
@@ -70,7 +101,8 @@ class TrajectoryAssociator {
 
   // Associates the detections b_t (lidar frame of scan `frame`, taken at time_s) seen from ego
   // pose X_t = T_world_lidar. Frames must increase; gaps are allowed (trajectories age by frame
-  // index). Every detection comes back with a track id: matched, or a new trajectory.
+  // index). Every tracked detection (its class has a policy, its score passes, it is no
+  // duplicate) comes back with a track id: matched, or a new trajectory.
   FrameAssociations associate(int frame, double time_s, const Pose& X_t, const std::vector<Box>& detections);
 
   const std::vector<Trajectory>& trajectories() const { return trajectories_; }
@@ -78,8 +110,19 @@ class TrajectoryAssociator {
   void reset();
 
  private:
-  // Drops trajectories unseen for too long and observations older than the window.
+  // Counts the frames missed since the last call, drops trajectories unseen for too long (their
+  // class's max_misses) and observations older than the window.
   int endAndSlide(int frame);
+  // Which detections are tracked: policy, score threshold, duplicate suppression.
+  std::vector<int> trackedDetections(const std::vector<Box>& detections, SkippedDetections& skipped) const;
+  // Eq. 6-7 per class: trajectory u's gate at this frame (see gateOf in the .cpp).
+  struct Gate {
+    Eigen::Vector2d center, along_unit;  // the prediction, the unit vector of the predicted motion
+    double along = 1, across = 1;        // semi-axes (equal for a circle)
+    // Distance of `p` in gates: < 1 inside.
+    double distance(const Eigen::Vector2d& p) const;
+  };
+  Gate gateOf(const Trajectory& tr, const Eigen::Vector3d& predicted, bool initialized, double time_s) const;
   // The position a trajectory predicts for time_s, and whether that prediction makes it initialized.
   Eigen::Vector3d predict(const Trajectory& tr, double time_s, bool* initialized) const;
 

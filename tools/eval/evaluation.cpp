@@ -75,6 +75,7 @@ Metrics evaluate(RunData run, const EvalOptions& options) {
     m.tracking = trackingMetrics(run.tracking, options.distance);
     m.tracking_iou = trackingMetrics(run.tracking, options.iou);
   }
+  if (run.kitti) m.kitti = evaluateKittiTracking({*run.kitti}, options.kitti);
   m.timing_ms = std::move(run.timing_ms);
   m.frame_counts = std::move(run.frame_counts);
   m.notes.insert(m.notes.end(), run.notes.begin(), run.notes.end());

@@ -12,6 +12,7 @@
 #include "dlslot/timing_stats.hpp"
 #include "ego_metrics.hpp"
 #include "hota.hpp"
+#include "kitti_protocol.hpp"
 #include "tracking_frames.hpp"
 
 namespace dlslot::eval {
@@ -24,6 +25,9 @@ struct RunData {
   bool has_tracks = false;
   bool track_velocities_given = false;  // tracks carry the system's own velocity estimate (SLOT_STATE)
   std::vector<TrackingFrame> tracking;
+  // The KITTI protocol's input (label rows with their 2-D boxes, results rows): set when the
+  // labels come from a KITTI label file.
+  std::optional<KittiSequence> kitti;
   std::map<std::string, TimingStats> timing_ms;  // module -> per-frame processing time
   std::map<std::string, int64_t> frame_counts;   // channel -> messages in the log
   std::vector<std::string> notes;                // facts for the report (process health, warnings)
@@ -34,6 +38,7 @@ struct EvalOptions {
   MatchCriterion iou{MatchCriterion::Kind::Iou3d};                      // second line
   double dynamic_speed_mps = 0.5;  // labels moving at least this fast count for the velocity RMSE
   std::vector<std::string> classes;  // evaluated classes; empty = all
+  KittiProtocolOptions kitti;
 };
 
 struct TrackingMetrics {
@@ -46,6 +51,7 @@ struct Metrics {
   std::string primary_source;                               // "slot", else "odometry", else the first
   std::map<std::string, std::optional<EgoMetrics>> ego;     // per source; null without ground truth
   std::optional<TrackingMetrics> tracking, tracking_iou;    // null without labels or without tracks
+  std::map<std::string, KittiClassMetrics> kitti;           // the KITTI protocol per class; empty without it
   std::string velocity_frame;                               // how velocities were compared
   std::map<std::string, TimingStats> timing_ms;
   std::map<std::string, int64_t> frame_counts;

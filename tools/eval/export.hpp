@@ -15,9 +15,14 @@ struct FrameTracks {
 };
 
 // One line per track and frame: frame id type 0 0 alpha x1 y1 x2 y2 h w l x y z rotation_y score,
-// in the rectified camera frame (bottom centre). The 2D box is the projection of the box's
-// corners with P2, or -1s when P2 is absent or a corner is not in front of the camera.
-void writeKittiTracks(const std::string& path, const std::vector<FrameTracks>& frames, const kitti::Calib& calib);
+// in the rectified camera frame (bottom centre), built by kitti::resultRow: the 2-D box is the box
+// projected with P2 and clipped to the image. Boxes not in the camera image are left out (the
+// devkit scores only what the camera sees). Throws when the calibration has no P2.
+struct ExportCount {
+  int written = 0, outside_image = 0;
+};
+ExportCount writeKittiTracks(const std::string& path, const std::vector<FrameTracks>& frames, const kitti::Calib& calib,
+                             const kitti::ImageSize& image = {});
 
 // Reads the same format back (labels or results) into lidar-frame boxes for frames 0..num_frames-1;
 // DontCare rows go to `dontcare` when given.

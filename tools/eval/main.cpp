@@ -31,6 +31,7 @@ struct Options {
   std::string out, export_dir;
   std::string classes;
   double match_distance = 2.0, min_iou = 0.25, dynamic_speed = 0.5, frame_period = 0.1;
+  double image_width = kitti::ImageSize().width, image_height = kitti::ImageSize().height;
   int track_max_unseen = 0;
   bool allow_missing_truth = false, quiet = false;
 };
@@ -48,8 +49,7 @@ Channels readChannels(const std::string& config) {
   // The default config is optional (the built-in channel names are the shipped ones); a config
   // given explicitly must exist.
   if (config == Options().config && !fs::exists(config)) return channels;
-  ConfigSection root = loadConfig(config);
-  channels.read(root.section("channels"));
+  loadPipelineConfig(config, channels);  // every section known (a misspelt one is an error)
   return channels;
 }
 
@@ -58,6 +58,7 @@ struct DataSet {
   std::optional<kitti::Calib> calib;
   std::optional<Trajectory> poses;
   std::optional<std::vector<FrameTracks>> labels, dontcare;
+  std::vector<kitti::LabelRow> label_rows;  // the label file as written (2-D boxes, truncation, occlusion)
   std::vector<double> stamps;
   int num_frames = 0;
 };
@@ -80,6 +81,7 @@ DataSet readDataSet(const Options& o) {
     if (!p.labels.empty()) {
       d.dontcare.emplace();
       d.labels = readKittiTracks(p.labels, *d.calib, d.num_frames, &*d.dontcare);
+      d.label_rows = kitti::readTrackingLabels(p.labels);
     }
   }
   if (!o.calib.empty()) d.calib = kitti::readCalib(o.calib);
@@ -127,7 +129,8 @@ void requireSameLength(const Trajectory& est, const std::string& est_file, const
                                       ") has " + std::to_string(gt.size()) + ": trajectories of different lengths");
 }
 
-void exportRun(const std::string& dir, const RunLog* log, const RunData& run, const DataSet& data) {
+void exportRun(const std::string& dir, const RunLog* log, const RunData& run, const DataSet& data,
+               const kitti::ImageSize& image) {
   fs::create_directories(dir);
   const std::optional<Pose> Tr = camFromVelo(data);
   std::map<std::string, Trajectory> trajectories = run.sources;
@@ -147,8 +150,61 @@ void exportRun(const std::string& dir, const RunLog* log, const RunData& run, co
       for (const Object& o : t.objects) f.boxes.push_back(o.box);
       frames.push_back(std::move(f));
     }
-    writeKittiTracks((fs::path(dir) / "tracks_kitti.txt").string(), frames, *data.calib);
+    const ExportCount n = writeKittiTracks((fs::path(dir) / "tracks_kitti.txt").string(), frames, *data.calib, image);
+    std::cerr << "dlslot-eval: tracks_kitti.txt: " << n.written << " rows; " << n.outside_image
+              << " track boxes outside the camera image left out\n";
   }
+}
+
+// The KITTI protocol's input for one sequence: the label file's rows and the results rows, either
+// read from a results file or made from the run's tracks with kitti::resultRow (boxes outside the
+// camera image are not scored, as they would not be written to a results file).
+KittiSequence kittiSequence(const Options& o, const DataSet& data, const std::map<int, RunLog::Tracks>& tracks,
+                            const std::set<int>& run_frames, const kitti::ImageSize& image,
+                            std::vector<std::string>& notes) {
+  KittiSequence seq;
+  seq.name = o.sequence;
+  seq.labels = data.label_rows;
+  for (int f : run_frames)
+    if (f >= 0 && f < data.num_frames) seq.frames.push_back(f);
+  if (!o.tracks.empty()) {
+    seq.tracks = kitti::readTrackingLabels(o.tracks);
+    int flat = 0, outside = 0;
+    for (const kitti::LabelRow& r : seq.tracks) {
+      flat += !(r.bbox2d[3] - r.bbox2d[1] > 0);
+      outside += !kitti::projectToImage(r.box, *data.calib, image);
+    }
+    if (flat > 0) {
+      notes.push_back("KITTI protocol: " + std::to_string(flat) + " of " + std::to_string(seq.tracks.size()) +
+                      " rows of " + o.tracks +
+                      " have no 2-D box (height <= 0): the devkit and AB3DMOT's script never count such a row as a "
+                      "false positive, so these numbers flatter the tracker; the 2-D box must be the 3-D box "
+                      "projected with P2 (kitti::resultRow)");
+      std::cerr << "dlslot-eval: warning: " << notes.back() << "\n";
+    }
+    if (outside > 0)
+      notes.push_back("KITTI protocol: " + std::to_string(outside) + " rows of " + o.tracks +
+                      " have a 3-D box outside the camera image; scored by their 2-D box, as the devkit does");
+  } else {
+    int outside = 0;
+    for (const auto& [frame, t] : tracks)
+      for (const Object& obj : t.objects) {
+        if (std::optional<kitti::LabelRow> row = kitti::resultRow(frame, obj.box, *data.calib, image))
+          seq.tracks.push_back(std::move(*row));
+        else
+          ++outside;
+      }
+    notes.push_back("KITTI protocol: " + std::to_string(seq.tracks.size()) + " track boxes in the camera image scored, " +
+                    std::to_string(outside) + " outside it not scored");
+  }
+  return seq;
+}
+
+std::vector<std::string> kittiClasses(const std::vector<std::string>& classes) {
+  std::vector<std::string> out;
+  for (const std::string& c : classes)
+    if (c == "Car" || c == "Pedestrian" || c == "Cyclist") out.push_back(c);
+  return out;
 }
 
 void addProcessNotes(const RunLog& log, RunData& run) {
@@ -181,10 +237,12 @@ int run(int argc, char** argv) {
   cl.option("--export", &o.export_dir, "write DIR/trajectory_<source>_<format>.txt and DIR/tracks_kitti.txt");
   cl.option("--classes", &o.classes, "evaluated classes, comma-separated (default: all)");
   cl.option("--match-distance", &o.match_distance, "centre-distance gate in metres (default 2)");
-  cl.option("--min-iou", &o.min_iou, "3D IoU gate of the second line (default 0.25)");
+  cl.option("--min-iou", &o.min_iou, "3D IoU gate of the second line and of the KITTI protocol (default 0.25)");
   cl.option("--dynamic-speed", &o.dynamic_speed, "labels at least this fast (m/s) are dynamic (default 0.5)");
   cl.option("--track-max-unseen", &o.track_max_unseen,
             "SLOT_STATE tracks not observed for more frames than this are not output (default 0)");
+  cl.option("--image-width", &o.image_width, "image_02 width in pixels for 2-D boxes (default 1242)");
+  cl.option("--image-height", &o.image_height, "image_02 height in pixels for 2-D boxes (default 375)");
   cl.option("--frame-period", &o.frame_period, "seconds per scan for files without timestamps (default 0.1)");
   cl.flag("--allow-missing-truth", &o.allow_missing_truth, "report timing alone when there is no ground truth");
   cl.flag("--quiet", &o.quiet, "no summary on stdout");
@@ -216,6 +274,17 @@ int run(int argc, char** argv) {
     run.timing_ms = log->timing_ms;
     run.frame_counts = log->frame_counts;
     addProcessNotes(*log, run);
+    if (!log->refused.empty()) {
+      std::ostringstream n;
+      int64_t total = 0;
+      for (const auto& [what, count] : log->refused) {
+        n << (total ? ", " : "") << what << " " << count;
+        total += count;
+      }
+      const std::string note = "log: " + std::to_string(total) + " events refused and skipped (" + n.str() + ")";
+      std::cerr << "dlslot-eval: " << o.log << ": " << note << "\n";
+      run.notes.push_back(note);
+    }
   }
   // Data-set files win over what the log carried.
   if (data.poses) run.truth = data.poses;
@@ -254,13 +323,21 @@ int run(int argc, char** argv) {
     std::cerr << "dlslot-eval: " << what << "; ego and tracking metrics are null\n";
   }
 
-  if (!o.export_dir.empty()) exportRun(o.export_dir, log ? &*log : nullptr, run, data);
+  const kitti::ImageSize image{o.image_width, o.image_height};
+  if (run.has_tracks && !data.label_rows.empty())
+    run.kitti = kittiSequence(o, data, tracks, run_frames, image, run.notes);
+  else if (run.has_tracks && run.has_labels)
+    run.notes.push_back("KITTI protocol not evaluated: it needs the label file (--kitti ROOT --sequence S) for the "
+                        "2-D boxes, truncation, occlusion and DontCare regions");
+  if (!o.export_dir.empty()) exportRun(o.export_dir, log ? &*log : nullptr, run, data, image);
 
   EvalOptions opt;
   opt.distance.max_distance_m = o.match_distance;
   opt.iou.min_iou = o.min_iou;
   opt.dynamic_speed_mps = o.dynamic_speed;
   opt.classes = splitList(o.classes);
+  opt.kitti.min_iou = o.min_iou;
+  opt.kitti.classes = kittiClasses(opt.classes);
   const std::map<std::string, Trajectory> sources = run.sources;
   const std::optional<Trajectory> truth = run.truth;
   const Metrics metrics = evaluate(std::move(run), opt);

@@ -62,6 +62,7 @@ std::vector<std::pair<std::string, Opt>> trackingValues(const std::optional<Trac
           {"velocity_rmse_mps", t ? t->clear.velocity_rmse_mps : std::nullopt}};
 }
 
+
 // A table rendered as Markdown with padded columns, so it reads well in a terminal too.
 class Table {
  public:
@@ -127,6 +128,20 @@ Table trackingTable(const Metrics& m) {
   return t;
 }
 
+Table kittiTable(const Metrics& m) {
+  Table t({"class", "sAMOTA", "AMOTA", "MOTA", "MOTP", "IDSW", "FRAG", "TP", "FP", "FN", "labels", "ignored labels",
+           "ignored tracks", "HOTA", "best MOTA", "at score", "AB3DMOT script: sAMOTA", "AMOTA", "best MOTA"});
+  for (const auto& [cls, k] : m.kitti)
+    t.row({cls, cell(k.sweep.samota, "%.4f"), cell(k.sweep.amota, "%.4f"), cell(k.all.mota, "%.4f"),
+           cell(k.all.motp, "%.4f"), std::to_string(k.all.idsw), std::to_string(k.all.frag), std::to_string(k.all.tp),
+           std::to_string(k.all.fp), std::to_string(k.all.fn), std::to_string(k.all.labels),
+           std::to_string(k.all.ignored_labels), std::to_string(k.all.ignored_tracks),
+           cell(k.hota ? Opt(k.hota->hota) : std::nullopt, "%.4f"), cell(k.sweep.best.mota, "%.4f"),
+           k.sweep.best_threshold ? cell(k.sweep.best_threshold, "%.4g") : "all", cell(k.sweep_ab3dmot.samota, "%.4f"),
+           cell(k.sweep_ab3dmot.amota, "%.4f"), cell(k.sweep_ab3dmot.best.mota, "%.4f")});
+  return t;
+}
+
 Table timingTable(const Metrics& m) {
   Table t({"module", "frames", "mean ms", "p95 ms", "max ms"});
   for (const auto& [module, s] : m.timing_ms)
@@ -144,6 +159,33 @@ void writeText(const std::string& path, const std::string& text) {
 
 }  // namespace
 
+// The KITTI protocol's keys of one class, tracking.<class>.<key>.
+std::vector<std::pair<std::string, std::optional<double>>> kittiValues(const KittiClassMetrics& k) {
+  const auto count = [](int v) -> std::optional<double> { return std::optional<double>(static_cast<double>(v)); };
+  return {{"mota", k.all.mota},
+          {"motp", k.all.motp},
+          {"samota", k.sweep.samota},
+          {"amota", k.sweep.amota},
+          {"idsw", count(k.all.idsw)},
+          {"frag", count(k.all.frag)},
+          {"tp", count(k.all.tp)},
+          {"fp", count(k.all.fp)},
+          {"fn", count(k.all.fn)},
+          {"labels", count(k.all.labels)},
+          {"ignored_labels", count(k.all.ignored_labels)},
+          {"ignored_tracks", count(k.all.ignored_tracks)},
+          {"hota", k.hota ? std::optional<double>(k.hota->hota) : std::nullopt},
+          {"deta", k.hota ? std::optional<double>(k.hota->deta) : std::nullopt},
+          {"assa", k.hota ? std::optional<double>(k.hota->assa) : std::nullopt},
+          {"recall_points", count(k.sweep.recall_points_reached)},
+          {"best_mota", k.sweep.best.mota},
+          {"best_idsw", count(k.sweep.best.idsw)},
+          {"best_threshold", k.sweep.best_threshold},
+          {"samota_ab3dmot", k.sweep_ab3dmot.samota},
+          {"amota_ab3dmot", k.sweep_ab3dmot.amota},
+          {"best_mota_ab3dmot", k.sweep_ab3dmot.best.mota}};
+}
+
 std::string metricsJson(const Metrics& m) {
   std::vector<std::pair<std::string, std::string>> kv;
   const auto ego_entries = [&](const std::string& prefix, const std::optional<EgoMetrics>& e) {
@@ -155,6 +197,8 @@ std::string metricsJson(const Metrics& m) {
   for (const auto& [name, e] : m.ego) ego_entries("sources." + name + ".", e);
   for (const auto& [key, v] : trackingValues(m.tracking)) kv.emplace_back("tracking." + key, num(v));
   for (const auto& [key, v] : trackingValues(m.tracking_iou)) kv.emplace_back("tracking_iou." + key, num(v));
+  for (const auto& [cls, k] : m.kitti)
+    for (const auto& [key, v] : kittiValues(k)) kv.emplace_back("tracking." + cls + "." + key, num(v));
   for (const auto& [module, s] : m.timing_ms) {
     kv.emplace_back("timing_ms." + module + ".mean", num(s.count() ? Opt(s.mean()) : std::nullopt));
     kv.emplace_back("timing_ms." + module + ".p95", num(s.count() ? Opt(s.percentile(95)) : std::nullopt));
@@ -191,6 +235,20 @@ std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plo
            "the IoU line, max(0, 1 - d / "
         << num(m.tracking->criterion.max_distance_m, "%g") << " m) of the centre distance d for the distance line.\n\n"
         << "Velocities: " << m.velocity_frame << ".\n\n";
+  }
+  if (!m.kitti.empty()) {
+    out << "## Tracking, KITTI protocol (3-D IoU >= " << num(m.kitti.begin()->second.min_iou, "%g")
+        << ", the devkit's ignore rules)\n\n"
+        << kittiTable(m).render() << "\n"
+        << "As the KITTI devkit and AB3DMOT's scripts/KITTI/evaluate.py count: camera frame, tracks outside the "
+           "image not scored; labels truncated (> 0), occluded (> 2) or of the neighbour class (Van, "
+           "Person_sitting) ignored; unmatched tracks of the neighbour class, at most 25 px tall or more than half "
+           "in a DontCare box ignored. MOTA, MOTP (mean 3-D IoU), IDSW, FRAG, TP (every match, ignored labels' "
+           "included), FP, FN: all tracks. sAMOTA / AMOTA: over 40 recall points from the tracks' mean scores. "
+           "Best MOTA: at the recall point's score threshold with the highest MOTA (AB3DMOT's single-threshold "
+           "line). AB3DMOT script: the same sweep with the script's drifting mean scores (its numbers to the digit; "
+           "it drops a track whose mean is itself the threshold at some recall points). HOTA: 3-D IoU similarity "
+           "after the ignore rules.\n\n";
   }
   out << "## Timing (per frame)\n\n";
   if (m.timing_ms.empty())
@@ -237,6 +295,9 @@ std::string summaryLine(const Metrics& m) {
         << m.tracking->clear.idsw;
   else
     out << "; no tracking evaluation";
+  for (const auto& [cls, k] : m.kitti)
+    out << "; " << cls << " sAMOTA " << cell(k.sweep.samota, "%.3f") << ", MOTA " << cell(k.all.mota, "%.3f") << ", IDSW "
+        << k.all.idsw;
   for (const char* module : {"odometry", "tracker", "backend"}) {
     const auto it = m.timing_ms.find(module);
     if (it != m.timing_ms.end()) out << "; " << module << " " << cell(it->second.mean(), "%.1f") << " ms";
@@ -248,6 +309,7 @@ void printSummary(std::ostream& out, const Metrics& m) {
   out << summaryLine(m) << "\n";
   if (!m.ego.empty()) out << "\n" << egoTable(m).render();
   if (m.tracking) out << "\n" << trackingTable(m).render();
+  if (!m.kitti.empty()) out << "\nKITTI protocol:\n" << kittiTable(m).render();
   if (!m.timing_ms.empty()) out << "\n" << timingTable(m).render();
 }
 

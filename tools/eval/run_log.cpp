@@ -3,13 +3,17 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include <cstdio>
+#include <algorithm>
 #include <filesystem>
+#include <optional>
+#include <type_traits>
 
 #include "dlslot/associations_t.hpp"
 #include "dlslot/convert.hpp"
 #include "dlslot/detections_t.hpp"
 #include "dlslot/ground_truth_t.hpp"
 #include "dlslot/input_error.hpp"
+#include "dlslot/message_guard.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/odometry_t.hpp"
 #include "dlslot/slot_state_t.hpp"
@@ -81,58 +85,75 @@ class LogReader {
                                      " complete events) do not form a complete event");
     if (count == 0) throw InputError(path_, 0, "the log holds no events");
     finishSlot();
+    run_.refused = refusals_.refusals();
     return std::move(run_);
   }
 
  private:
+  // Decodes through the guard (one place for every reader, message_guard.hpp); a refused event
+  // is skipped, counted by channel and reason, and logged once per reason.
   template <class Msg>
-  Msg decode(const lcm::LogEvent& ev, int64_t index, const char* type) {
+  std::optional<Msg> decode(const lcm::LogEvent& ev, int64_t index) {
     Msg msg;
-    if (msg.decode(ev.data, 0, ev.datalen) < 0)
-      throw InputError(path_, 0, "event " + std::to_string(index) + " on channel " + ev.channel +
-                                     " does not decode as dlslot." + type + " (corrupt log or wrong message type)");
+    Refusal why = decodeChecked(ev.data, static_cast<size_t>(std::max(ev.datalen, 0)), &msg);
+    if constexpr (!std::is_same_v<Msg, process_status_t>)
+      if (!why) why = order_[ev.channel].accept(msg.frame);
+    if (why) {
+      refusals_.refused(ev.channel, why, path_ + ": event " + std::to_string(index) + ": ");
+      return std::nullopt;
+    }
     return msg;
   }
 
   void handle(const lcm::LogEvent& ev, int64_t index) {
     const std::string& c = ev.channel;
-    if (run_.frame_counts.count(c)) ++run_.frame_counts[c];
     if (c == ch_.odometry) {
-      const auto m = decode<odometry_t>(ev, index, "odometry_t");
-      odometry_[m.frame] = {seconds(m.utime), fromMsg(m.pose)};
-      addTimings(run_, "odometry", m.timings);
-      run_.frames.insert(m.frame);
+      const auto m = decode<odometry_t>(ev, index);
+      if (!m) return;
+      odometry_[m->frame] = {seconds(m->utime), fromMsg(m->pose)};
+      addTimings(run_, "odometry", m->timings);
+      run_.frames.insert(m->frame);
     } else if (c == ch_.slot_state) {
-      const auto m = decode<slot_state_t>(ev, index, "slot_state_t");
-      slot_[m.frame] = {seconds(m.utime), fromMsg(m.ego_pose)};
-      if (m.has_smoothed) smoothed_[m.smoothed_frame] = {seconds(m.smoothed_utime), fromMsg(m.smoothed_pose)};
-      run_.tracks[m.frame] = tracksOf(m, track_max_unseen_);
-      addTimings(run_, "backend", m.timings);
-      run_.frames.insert(m.frame);
+      const auto m = decode<slot_state_t>(ev, index);
+      if (!m) return;
+      slot_[m->frame] = {seconds(m->utime), fromMsg(m->ego_pose)};
+      if (m->has_smoothed) smoothed_[m->smoothed_frame] = {seconds(m->smoothed_utime), fromMsg(m->smoothed_pose)};
+      run_.tracks[m->frame] = tracksOf(*m, track_max_unseen_);
+      addTimings(run_, "backend", m->timings);
+      run_.frames.insert(m->frame);
     } else if (c == ch_.associations) {
-      const auto m = decode<associations_t>(ev, index, "associations_t");
-      addTimings(run_, "tracker", m.timings);
-      run_.frames.insert(m.frame);
+      const auto m = decode<associations_t>(ev, index);
+      if (!m) return;
+      addTimings(run_, "tracker", m->timings);
+      run_.frames.insert(m->frame);
     } else if (c == ch_.ground_truth) {
-      const auto m = decode<ground_truth_t>(ev, index, "ground_truth_t");
-      if (m.has_pose) truth_[m.frame] = {seconds(m.utime), fromMsg(m.pose)};
-      RunLog::Labels& l = run_.labels[m.frame];
-      l.stamp = seconds(m.utime);
-      l.boxes = fromMsg(m.boxes);
+      const auto m = decode<ground_truth_t>(ev, index);
+      if (!m) return;
+      if (m->has_pose) truth_[m->frame] = {seconds(m->utime), fromMsg(m->pose)};
+      RunLog::Labels& l = run_.labels[m->frame];
+      l.stamp = seconds(m->utime);
+      l.boxes = fromMsg(m->boxes);
       l.dontcare.clear();
-      for (const box_t& b : m.dontcare)  // DontCare without a 3D extent cannot be matched in 3D
+      for (const box_t& b : m->dontcare)  // DontCare without a 3D extent cannot be matched in 3D
         if (b.size[0] > 0 && b.size[1] > 0 && b.size[2] > 0) l.dontcare.push_back(fromMsg(b));
-      run_.frames.insert(m.frame);
-    } else if (c == ch_.scan) {  // not decoded: only its frame index is needed
-      const int frame = frameOfEncoded(ev.data, ev.datalen);
-      if (frame < 0) throw InputError(path_, 0, "event " + std::to_string(index) + " on channel " + c + " is too short");
-      run_.frames.insert(frame);
+      run_.frames.insert(m->frame);
+    } else if (c == ch_.scan) {
+      const auto m = decode<point_cloud_t>(ev, index);
+      if (!m) return;
+      run_.frames.insert(m->frame);
     } else if (c == ch_.detections) {
-      run_.frames.insert(decode<detections_t>(ev, index, "detections_t").frame);
+      const auto m = decode<detections_t>(ev, index);
+      if (!m) return;
+      run_.frames.insert(m->frame);
     } else if (c == ch_.status) {
-      const auto m = decode<process_status_t>(ev, index, "process_status_t");
-      run_.last_status[m.name] = m;
+      const auto m = decode<process_status_t>(ev, index);
+      if (!m) return;
+      run_.last_status[m->name] = *m;
+      return;
+    } else {
+      return;
     }
+    ++run_.frame_counts[c];
   }
 
   static Trajectory toTrajectory(const std::map<int, std::pair<double, Pose>>& poses) {
@@ -159,6 +180,8 @@ class LogReader {
   int track_max_unseen_;
   RunLog run_;
   std::map<int, std::pair<double, Pose>> odometry_, slot_, smoothed_, truth_;
+  ProcessStatus refusals_{"eval"};
+  std::map<std::string, FrameOrder> order_;
 };
 
 }  // namespace

@@ -30,12 +30,14 @@ struct RunLog {
   std::map<int, Tracks> tracks;  // SLOT_STATE tracks by frame
   std::set<int> frames;          // every frame index a pipeline message carried
   std::map<std::string, TimingStats> timing_ms;  // "<process>" (stage "total") or "<process>.<stage>"
-  std::map<std::string, int64_t> frame_counts;   // messages per frame channel
+  std::map<std::string, int64_t> frame_counts;   // accepted messages per frame channel
+  std::map<std::string, int64_t> refused;        // "CHANNEL.REASON" -> events skipped (message_guard.hpp)
   std::map<std::string, process_status_t> last_status;  // by process name
 };
 
 // Reads every event; throws InputError naming the file for a missing, empty, truncated or corrupt
-// log and for a message on a known channel that does not decode. Tracks not observed within the
+// log; a message that the guard refuses (message_guard.hpp) is skipped, logged and counted in
+// `refused`. Tracks not observed within the
 // last `track_max_unseen` frames (track_t.last_seen_frame) are not part of a frame's output.
 RunLog readRunLog(const std::string& path, const Channels& channels, int track_max_unseen = 0);
 

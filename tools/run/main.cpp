@@ -74,6 +74,7 @@ int runPipeline(int argc, char** argv) {
   cl.flag("--quiet", &quiet, "no progress line");
   if (!cl.parse(argc, argv)) return 0;
   if (out.empty()) throw std::invalid_argument("--out DIR is required");
+  config = fs::absolute(findConfigFile(config)).string();  // the children get the same file from any directory
   if (root.empty() == scenario.empty()) throw std::invalid_argument("give either --kitti ROOT or --scenario NAME");
   const ModeSettings ms = settingsFor(mode);
   const std::string bin = binDir();
@@ -227,6 +228,15 @@ int runPipeline(int argc, char** argv) {
   std::fprintf(stderr, "SLOT_STATE for %d of %d frames; pipeline rate %.2f frames/s (%s)\n", slot_frames,
                last_frame + 1, play_s > 0 ? slot_frames / play_s : 0.0, speed > 0 ? "rate mode" : "lockstep");
   if (slot_frames != last_frame + 1) std::cerr << "warning: frames are missing from SLOT_STATE\n";
+  if (const auto refused = node.status().refusals(); !refused.empty()) {
+    std::string what;
+    int64_t total = 0;
+    for (const auto& [key, n] : refused) {
+      what += (total ? ", " : "") + key + " " + std::to_string(n);
+      total += n;
+    }
+    std::fprintf(stderr, "launcher: refused %lld messages (%s)\n", static_cast<long long>(total), what.c_str());
+  }
 
   // 6. Evaluate and export.
   if (!no_eval) {

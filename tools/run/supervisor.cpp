@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -17,15 +18,22 @@ namespace dlslot::run {
 Supervisor::~Supervisor() { stopAll(2.0); }
 
 void Supervisor::start(const std::string& name, const std::vector<std::string>& argv, const std::string& log_path) {
+  const pid_t parent = getpid(), group = group_;
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error("cannot start " + name + ": fork failed");
   if (pid == 0) {
+    // No child outlives the launcher, however it ends (SIGKILL included): the kernel sends SIGTERM
+    // (a clean stop: the logger closes its log) when the launcher dies. It may have died already.
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(128 + SIGTERM);
     const int fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (fd >= 0) {
       dup2(fd, 1);
       dup2(fd, 2);
     }
-    setpgid(0, 0);  // a Ctrl-C on the terminal reaches the launcher, which stops children in order
+    // One process group for all children, apart from the launcher's: a Ctrl-C on the terminal
+    // reaches the launcher, which stops them in order (a new group when the old one is gone).
+    if (setpgid(0, group) != 0) setpgid(0, 0);
     std::vector<char*> args;
     for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
@@ -33,6 +41,8 @@ void Supervisor::start(const std::string& name, const std::vector<std::string>& 
     std::fprintf(stderr, "cannot execute %s\n", args[0]);
     _exit(127);
   }
+  if (setpgid(pid, group) != 0) setpgid(pid, pid);  // the same in the parent: no race with exec
+  if (const pid_t g = getpgid(pid); g > 0) group_ = g;
   children_.push_back({name, log_path, pid});
 }
 

@@ -16,6 +16,7 @@ class Supervisor {
   ~Supervisor();  // stops whatever still runs
 
   // Starts argv[0] with argv; output to log_path. Throws std::runtime_error when fork fails.
+  // Children share one process group (not the launcher's) and get SIGTERM when the launcher dies.
   void start(const std::string& name, const std::vector<std::string>& argv, const std::string& log_path);
 
   // A child that has exited and was not reported yet (running() may have noticed the exit
@@ -52,6 +53,7 @@ class Supervisor {
   const Child& find(const std::string& name) const;
   static std::string describe(int code);
   std::vector<Child> children_;
+  pid_t group_ = 0;  // the children's process group (0: none yet)
 };
 
 // Reads a small text file whole ("" when missing).

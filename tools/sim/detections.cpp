@@ -8,12 +8,12 @@
 namespace dlslot::sim {
 namespace {
 
-double sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
-
-// Mean logit of a true positive's score: rises with the points on the object.
+// Scores are raw logits, as PointRCNN publishes them (the tracker's score_scale: logit, and its
+// per-class min_score thresholds, hold for both). Mean logit of a true positive: rises with the
+// points on the object, from about -1 (a few points) to 9 (a well-seen object).
 double scoreLogit(const std::string& type, int points) {
   const double scale = isVehicle(type) ? 80.0 : 30.0;
-  return -0.5 + 4.0 * (1.0 - std::exp(-points / scale));
+  return -1.0 + 10.0 * (1.0 - std::exp(-points / scale));
 }
 
 Box noisy(const Box& truth, const DetectorSpec& spec, Rng& rng) {
@@ -75,7 +75,7 @@ std::vector<kitti::LabelRow> detect(int frame, const std::vector<DetectorTarget>
     if (!rng.chance(p)) continue;
     const Box b = noisy(t.box, spec, rng);
     rows.push_back(
-        detectionRow(frame, t.track_id, b, sigmoid(rng.normal(scoreLogit(t.box.type, t.points), 0.8)), calib));
+        detectionRow(frame, t.track_id, b, rng.normal(scoreLogit(t.box.type, t.points), 1.5), calib));
   }
   // Points per structure this frame, and the static points near enough to fool the detector.
   std::vector<int> hits(world.structures.size(), 0);
@@ -90,7 +90,7 @@ std::vector<kitti::LabelRow> detect(int frame, const std::vector<DetectorTarget>
     const Eigen::Vector2d base = world.structures[s].base.head<2>();
     if ((base - T_map_lidar.translation().head<2>()).norm() > 40.0) continue;
     const Box b = phantom(rng.chance(0.8) ? "Pedestrian" : "Cyclist", base, world, T_map_lidar, rng);
-    rows.push_back(detectionRow(frame, -1, b, sigmoid(rng.normal(-0.3, 0.8)), calib));
+    rows.push_back(detectionRow(frame, -1, b, rng.normal(0.0, 1.5), calib));
   }
   const int random_fp = clutter.empty() ? 0 : rng.poisson(spec.false_positives_per_frame);
   for (int k = 0; k < random_fp; ++k) {
@@ -101,7 +101,7 @@ std::vector<kitti::LabelRow> detect(int frame, const std::vector<DetectorTarget>
                           : u < 0.85 ? "Pedestrian"
                                      : "Cyclist",
                           p_map.head<2>(), world, T_map_lidar, rng);
-    rows.push_back(detectionRow(frame, -1, b, sigmoid(rng.normal(-1.0, 0.8)), calib));
+    rows.push_back(detectionRow(frame, -1, b, rng.normal(-1.0, 1.5), calib));
   }
   return rows;
 }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "rng.hpp"
+
 namespace dlslot::sim {
 
 SolidGrid::SolidGrid(const std::vector<Solid>& solids, double cell_m) : solids_(solids), cell_(cell_m) {
@@ -50,8 +52,8 @@ bool SolidGrid::cellOf(double x, double y, int& ix, int& iy) const {
   return inside;
 }
 
-int SolidGrid::cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double& s,
-                    Scratch& scratch) const {
+int SolidGrid::cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double& s, Scratch& scratch,
+                    const uint64_t* ray_key) const {
   if (solids_.empty()) return -1;
   constexpr double kInf = std::numeric_limits<double>::infinity();
   // Clip the ray to the grid's rectangle.
@@ -96,7 +98,11 @@ int SolidGrid::cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double m
         if (scratch.stamp[i] == scratch.ray) continue;
         scratch.stamp[i] = scratch.ray;
         double hit;
-        if (intersect(solids_[i], o, d, best_s, hit)) {
+        const Solid& solid = solids_[i];
+        const bool hits = ray_key && solid.mean_free_path > 0
+                              ? intersectPorous(solid, o, d, best_s, Rng(streamKey({*ray_key, i})).uniform(), hit)
+                              : intersect(solid, o, d, best_s, hit);
+        if (hits) {
           best_s = hit;
           best = static_cast<int>(i);
         }

@@ -23,7 +23,10 @@ class SolidGrid {
   Scratch scratch() const { return {std::vector<uint32_t>(solids_.size(), 0), 0}; }
 
   // Index of the nearest solid hit by the unit ray (o, d) before max_s, or -1; s = its distance.
-  int cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double& s, Scratch& scratch) const;
+  // With a ray key, porous solids stop the ray inside or let it through (intersectPorous, one draw
+  // per ray and solid from the key); without one, every solid is opaque.
+  int cast(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double& s, Scratch& scratch,
+           const uint64_t* ray_key = nullptr) const;
   // Indices of the solids whose cells meet the axis-aligned rectangle [lo, hi] (may repeat).
   std::vector<int> near(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const;
   const std::vector<Solid>& solids() const { return solids_; }

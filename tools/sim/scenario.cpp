@@ -191,9 +191,28 @@ void readSensor(Section s, SensorSpec& o) {
   if (o.azimuth_steps < 100) s.fail("azimuth_steps", "expected at least 100");
   s.optional("max_range_m", o.max_range_m);
   s.optional("min_range_m", o.min_range_m);
-  s.optional("range_noise_m", o.range_noise_m);
-  s.fraction("dropout", o.dropout);
   s.optional("height_m", o.height_m);
+  auto nonNegative = [&](const char* key, double& v) {
+    s.optional(key, v);
+    if (!(v >= 0)) s.fail(key, "expected a number >= 0, got " + std::to_string(v));
+  };
+  nonNegative("range_noise_m", o.range_noise_m);
+  nonNegative("range_noise_per_100m", o.range_noise_per_100m);
+  nonNegative("beam_divergence_mrad", o.beam_divergence_mrad);
+  nonNegative("footprint_noise", o.footprint_noise);
+  s.fraction("dropout", o.dropout);
+  nonNegative("dropout_signal", o.dropout_signal);
+  if (s.has("dropout_steepness")) o.dropout_steepness = s.positive("dropout_steepness");
+  s.optional("azimuth_phase", o.azimuth_phase);
+  nonNegative("beam_elevation_error_deg", o.beam_elevation_error_deg);
+  nonNegative("beam_azimuth_error_deg", o.beam_azimuth_error_deg);
+  nonNegative("beam_range_bias_m", o.beam_range_bias_m);
+  s.optional("vertical_angle_error_deg", o.vertical_angle_error_deg);
+  s.optional("motion_distortion", o.motion_distortion);
+  s.optional("deskewed", o.deskewed);
+  nonNegative("vegetation_mean_free_path_m", o.vegetation_mean_free_path_m);
+  s.fraction("fences", o.fences);
+  s.fraction("fence_pass", o.fence_pass);
   s.cfg.finish();
 }
 
@@ -266,6 +285,12 @@ Scenario loadScenario(const std::string& path) {
     sc.ego.path = readPath(e, sc.roads);
     if (sc.ego.path.crossing_s_m) e.fail("crossing", "the ego drives on a road lane or a route");
     e.optional("start_s_m", sc.ego.start_s_m);
+    if (e.has("body_pitch_roll_deg")) {
+      sc.ego.body_pitch_roll = e.cfg.get<double>("body_pitch_roll_deg") * kDeg;
+      if (!(sc.ego.body_pitch_roll >= 0)) e.fail("body_pitch_roll_deg", "expected a number >= 0");
+    }
+    e.optional("body_heave_m", sc.ego.body_heave_m);
+    if (!(sc.ego.body_heave_m >= 0)) e.fail("body_heave_m", "expected a number >= 0");
     sc.ego.speed_profile = e.pairs("speed_mps");
     for (size_t i = 1; i < sc.ego.speed_profile.size(); ++i)
       if (sc.ego.speed_profile[i].first <= sc.ego.speed_profile[i - 1].first)

@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -83,6 +84,11 @@ struct EgoSpec {
   PathSpec path;
   double start_s_m = 0.0;
   std::vector<std::pair<double, double>> speed_profile;  // (time s, speed m/s) knots
+  // The body's ride on its suspension (issue 15): rms pitch and roll (rad) and rms heave (m), each a
+  // sum of three sinusoids of 0.7-2.5 Hz with seeded phases. The lidar turns with the body, during
+  // the sweep too. 0 = a rigid ride.
+  double body_pitch_roll = 0.5 * M_PI / 180.0;
+  double body_heave_m = 0.005;
 };
 
 struct TrafficSpec {
@@ -95,12 +101,30 @@ struct TrafficSpec {
   double stop_probability = 0.0;  // chance an agent stops for a while somewhere
 };
 
-struct SensorSpec {  // HDL-64E-like (issue 3)
+struct SensorSpec {  // HDL-64E-like (issue 3); the imperfections of a real one (issue 15), see sensor_model.hpp
   int azimuth_steps = 2000;
   double max_range_m = 120.0, min_range_m = 2.5;
-  double range_noise_m = 0.02;
-  double dropout = 0.02;
   double height_m = 1.73;
+  // Range noise: sigma_0 + per-100-m growth, in quadrature with the footprint's depth spread.
+  double range_noise_m = 0.02;
+  double range_noise_per_100m = 0.02;
+  double beam_divergence_mrad = 2.0;
+  double footprint_noise = 0.25;  // sigma as a fraction of r * divergence * tan(incidence); 0 = off
+  // Lost returns: random, and where the received signal is weak (0 = off).
+  double dropout = 0.02;
+  double dropout_signal = 0.02, dropout_steepness = 2.0;
+  bool azimuth_phase = true;  // firing phase changes from revolution to revolution
+  // Per-beam calibration residuals (sigmas, drawn once per seed) and KITTI's common vertical error.
+  double beam_elevation_error_deg = 0.05, beam_azimuth_error_deg = 0.05, beam_range_bias_m = 0.02;
+  // KITTI's scans: the rays point 0.22 deg higher than the stored points say (on by default: it is
+  // what makes A-LOAM drift as on KITTI, see config/scenarios/README.md; 0 = off).
+  double vertical_angle_error_deg = 0.22;
+  bool motion_distortion = true;  // points fired across the sweep while everything moves
+  bool deskewed = false;          // written in the reference-time frame (KITTI odometry), not as seen
+  // Partly transparent clutter: rays go into tree crowns and bushes an exponential depth of this
+  // mean (0 = solid), and this fraction of the gaps' walls are wire fences passing fence_pass of the rays.
+  double vegetation_mean_free_path_m = 0.6;
+  double fences = 0.5, fence_pass = 0.5;
 };
 
 struct GroundSpec {

@@ -1,5 +1,6 @@
 #include "simulation.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "calib.hpp"
@@ -14,7 +15,8 @@ Simulation::Simulation(const Scenario& scenario)
       motion_(simulateMotion(scenario_, world_)),
       calib_(kittiCalib()),
       ghosts_(chooseGhosts(world_, scenario_.detector, streamKey({scenario_.seed, 5}))),
-      track_id_(motion_.agents.size(), -1) {}
+      track_id_(motion_.agents.size(), -1),
+      beam_errors_(beamErrors(scenario_.sensor, streamKey({scenario_.seed, 8}))) {}
 
 std::vector<Pose> Simulation::lidarPoses() const {
   std::vector<Pose> poses;
@@ -30,6 +32,11 @@ Simulation::FrameData Simulation::frame(int index, int threads) {
   ScanInput& in = fd.input;
   in.world = &world_;
   in.T_map_lidar = motion_.ego[index];
+  const int frames = static_cast<int>(motion_.ego.size());
+  in.period_s = scenario_.frame_period_s;
+  in.ego = sweepMotion(index > 0 ? &motion_.ego[index - 1] : nullptr, in.T_map_lidar,
+                       index + 1 < frames ? &motion_.ego[index + 1] : nullptr, in.period_s);
+  in.beam_errors = beam_errors_;
   in.key = streamKey({scenario_.seed, 6, static_cast<uint64_t>(index)});
   const Pose T_lidar_map = in.T_map_lidar.inverse();
   // Objects within the lidar's range (with a margin for their size) take part in this frame.
@@ -39,6 +46,12 @@ Simulation::FrameData Simulation::frame(int index, int threads) {
     if ((b.center - in.T_map_lidar.translation()).head<2>().norm() > scenario_.sensor.max_range_m + 10.0) continue;
     agentSolids(motion_.agents[i], static_cast<int>(agent_of.size()), index, *world_.ground, in.object_solids);
     in.object_boxes.push_back(b);
+    // Its velocity over this frame's sweep (central difference; objects turn little in 50 ms).
+    const int lo = std::max(0, index - 1), hi = std::min(frames - 1, index + 1);
+    in.object_velocity.push_back(hi > lo ? Eigen::Vector3d((agentBox(motion_.agents[i], hi, *world_.ground).center -
+                                                            agentBox(motion_.agents[i], lo, *world_.ground).center) /
+                                                           ((hi - lo) * in.period_s))
+                                         : Eigen::Vector3d::Zero());
     agent_of.push_back(static_cast<int>(i));
   }
   fd.scan = scan(scenario_.sensor, in, threads);

@@ -1,6 +1,7 @@
 #include "solid.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <limits>
 #include <vector>
@@ -99,6 +100,36 @@ bool intersectSphere(const Solid& sp, const Eigen::Vector3d& o, const Eigen::Vec
   return true;
 }
 
+bool chordBox(const Solid& b, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double& s_in, double& s_out) {
+  const double rx = o.x() - b.center.x(), ry = o.y() - b.center.y();
+  const double lo[3] = {b.cos_yaw * rx + b.sin_yaw * ry, -b.sin_yaw * rx + b.cos_yaw * ry, o.z() - b.center.z()};
+  const double ld[3] = {b.cos_yaw * d.x() + b.sin_yaw * d.y(), -b.sin_yaw * d.x() + b.cos_yaw * d.y(), d.z()};
+  s_in = -std::numeric_limits<double>::infinity();
+  s_out = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(ld[i]) < 1e-12) {
+      if (std::abs(lo[i]) > b.half[i]) return false;
+      continue;
+    }
+    double t1 = (-b.half[i] - lo[i]) / ld[i], t2 = (b.half[i] - lo[i]) / ld[i];
+    if (t1 > t2) std::swap(t1, t2);
+    s_in = std::max(s_in, t1);
+    s_out = std::min(s_out, t2);
+    if (s_in > s_out) return false;
+  }
+  return s_out > 0;
+}
+
+bool chordSphere(const Solid& sp, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double& s_in, double& s_out) {
+  const Eigen::Vector3d oc = o - sp.center;
+  const double bh = oc.dot(d), cc = oc.squaredNorm() - sp.half.x() * sp.half.x();
+  const double disc = bh * bh - cc;
+  if (disc < 0) return false;
+  s_in = -bh - std::sqrt(disc);
+  s_out = -bh + std::sqrt(disc);
+  return s_out > 0;
+}
+
 // Footprint as a polygon (boxes) or a circle, for separating-axis tests in the plane.
 struct Footprint {
   bool circle = false;
@@ -184,6 +215,26 @@ Eigen::Vector3d normalAt(const Solid& solid, const Eigen::Vector3d& p) {
     }
   }
   return Eigen::Vector3d::UnitZ();
+}
+
+bool chord(const Solid& solid, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double& s_in, double& s_out) {
+  switch (solid.kind) {
+    case SolidKind::Box: return chordBox(solid, o, d, s_in, s_out);
+    case SolidKind::Sphere: return chordSphere(solid, o, d, s_in, s_out);
+    case SolidKind::Cylinder: return false;
+  }
+  return false;
+}
+
+bool intersectPorous(const Solid& solid, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double u,
+                     double& s) {
+  if (solid.mean_free_path <= 0) return intersect(solid, o, d, max_s, s);
+  double s_in, s_out;
+  if (!chord(solid, o, d, s_in, s_out) || s_in <= 0) return false;  // like intersect(): not from inside
+  const double hit = s_in - solid.mean_free_path * std::log(1.0 - u);
+  if (hit >= s_out || hit >= max_s) return false;
+  s = hit;
+  return true;
 }
 
 bool overlaps(const Solid& a, const Solid& b, double margin) {

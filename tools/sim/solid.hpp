@@ -17,6 +17,7 @@ struct Solid {
                                                      // cylinder: (r, r, half height); sphere: (r, r, r)
   double cos_yaw = 1.0, sin_yaw = 0.0;               // boxes only
   float reflectivity = 0.2f;                         // KITTI-like reflectance of the surface, 0..1
+  float mean_free_path = 0.0f;                       // > 0: porous (foliage, wire fence), see intersectPorous
   int owner = -1;                                    // what it belongs to (an object, a static structure)
 
   static Solid box(const Eigen::Vector3d& center, const Eigen::Vector3d& size, double yaw, float reflectivity);
@@ -31,6 +32,14 @@ struct Solid {
 // Distance along the unit ray (o, d) to the solid's surface if it is hit in (0, max_s); rays
 // starting inside a solid do not hit it.
 bool intersect(const Solid& solid, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double& s);
+// Where the unit ray (o, d) enters and leaves the solid (s_in may be <= 0 when o is inside); boxes
+// and spheres only (cylinders: false).
+bool chord(const Solid& solid, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double& s_in, double& s_out);
+// A porous solid stops the ray an exponential depth of mean `mean_free_path` after it enters,
+// -mean_free_path * ln(1 - u) with u uniform in [0, 1) (one draw per ray and solid), if that is
+// before it leaves and before max_s; otherwise the ray passes through. Opaque solids: intersect().
+bool intersectPorous(const Solid& solid, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double u,
+                     double& s);
 // Outward unit normal of the surface at (or next to) p.
 Eigen::Vector3d normalAt(const Solid& solid, const Eigen::Vector3d& p);
 // True when the two solids' footprints overlap (grown by `margin`) and their height ranges meet.

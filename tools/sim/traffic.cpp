@@ -89,6 +89,33 @@ Pose egoPose(const Eigen::Vector2d& xy, double heading, const Ground& ground, do
 
 }  // namespace
 
+BodyRide::BodyRide(const EgoSpec& ego, uint64_t key) {
+  Rng rng(key);
+  // Three sinusoids of equal amplitude have an rms of amplitude * sqrt(3/2).
+  const double scale[3] = {ego.body_pitch_roll, ego.body_pitch_roll, ego.body_heave_m};
+  for (int axis = 0; axis < 3; ++axis)
+    for (Wave& w : waves_[axis]) {
+      w.amplitude = scale[axis] / std::sqrt(1.5);
+      w.hz = rng.uniform(0.7, 2.5);
+      w.phase = rng.uniform(0, 2 * M_PI);
+    }
+}
+
+double BodyRide::value(int axis, double t) const {
+  double v = 0;
+  for (const Wave& w : waves_[axis]) v += w.amplitude * std::sin(2 * M_PI * w.hz * t + w.phase);
+  return v;
+}
+
+Pose BodyRide::at(double t) const {
+  Pose T = Pose::Identity();
+  T.linear() = (Eigen::AngleAxisd(value(1, t), Eigen::Vector3d::UnitX()) *
+                Eigen::AngleAxisd(value(0, t), Eigen::Vector3d::UnitY()))
+                   .toRotationMatrix();
+  T.translation().z() = value(2, t);
+  return T;
+}
+
 Box agentBox(const Agent& agent, int frame, const Ground& ground) {
   Box b;
   const Eigen::Vector2d xy = agent.xy[frame];
@@ -257,9 +284,10 @@ Motion simulateMotion(const Scenario& sc, const World& world) {
     }
   }
 
+  const BodyRide ride(sc.ego, streamKey({sc.seed, 10}));
   for (int f = 0; f < sc.frames; ++f) {
     const Path::Sample at = movers[0].path->at(tr.s[0][f]);
-    out.ego.push_back(egoPose(at.p, at.heading, ground, sc.sensor.height_m));
+    out.ego.push_back(egoPose(at.p, at.heading, ground, sc.sensor.height_m) * ride.at(f * sc.frame_period_s));
   }
   for (size_t i = 1; i < movers.size(); ++i) {
     if (!alive[i]) continue;

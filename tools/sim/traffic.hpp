@@ -6,6 +6,7 @@
 // along the roads' parking strips.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,21 @@ struct Motion {
   std::vector<Agent> agents;
   std::vector<Pose> ego;  // T_map_lidar per frame
   int removed = 0;        // objects dropped because their paths would overlap
+};
+
+// The ego body's pitch, roll and heave on its suspension (EgoSpec), as a pose in the lidar frame
+// of the road-following pose: T_map_lidar = T_road * at(t).
+class BodyRide {
+ public:
+  BodyRide(const EgoSpec& ego, uint64_t key);
+  Pose at(double t) const;
+  double value(int axis, double t) const;  // axis 0 pitch (rad), 1 roll (rad), 2 heave (m)
+
+ private:
+  struct Wave {
+    double amplitude = 0, hz = 0, phase = 0;
+  };
+  std::array<std::array<Wave, 3>, 3> waves_{};
 };
 
 Motion simulateMotion(const Scenario& scenario, const World& world);

@@ -33,7 +33,8 @@ std::vector<Eigen::Vector2d> outline(const Solid& s) {
 
 class RoadsideBuilder {
  public:
-  RoadsideBuilder(World& world, uint64_t key) : w_(world), rng_(key) {}
+  RoadsideBuilder(World& world, uint64_t key, const SensorSpec& sensor, uint64_t fence_key)
+      : w_(world), rng_(key), sensor_(sensor), fence_key_(fence_key) {}
 
   void build(const Road& road) {
     const RoadsideSpec& rs = road.spec->roadside;
@@ -119,7 +120,17 @@ class RoadsideBuilder {
         const double ws = s + (building ? length : 0.0);
         const Path::Sample at = road.centre.at(ws + 0.5 * open);
         const Eigen::Vector2d c = at.p + side * (rs.frontage_m + 0.15) * leftOf(at.heading);
-        add(StructureKind::Wall, {standing(c, at.heading, open, 0.3, rng_.uniform(1.2, 2.6), 0.3f)}, road);
+        Solid wall = standing(c, at.heading, open, 0.3, rng_.uniform(1.2, 2.6), 0.3f);
+        // Some are wire fences that many rays pass (a draw of their own, so the roadside's other
+        // draws stay as they were). Thickness t passes exp(-t / mean_free_path) of square-on rays.
+        if (sensor_.fence_pass > 0 && sensor_.fence_pass < 1 &&
+            Rng(streamKey({fence_key_, walls_++})).chance(sensor_.fences)) {
+          constexpr double kThick = 0.05;
+          wall.half.y() = 0.5 * kThick;
+          wall.reflectivity = 0.4f;
+          wall.mean_free_path = static_cast<float>(-kThick / std::log(sensor_.fence_pass));
+        }
+        add(StructureKind::Wall, {wall}, road);
       }
       s += length + gap;
     }
@@ -161,7 +172,8 @@ class RoadsideBuilder {
       for (int attempt = 0; attempt < 3; ++attempt, crown *= 0.7) {  // smaller crowns where lanes are close
         const Solid t = Solid::cylinder(c, g - 0.2, g + trunk, rng_.uniform(0.12, 0.3), 0.2f);
         // The crown sits on the trunk: people walk under it.
-        const Solid k = Solid::sphere(Eigen::Vector3d(c.x(), c.y(), g + trunk + crown), crown, 0.12f);
+        Solid k = Solid::sphere(Eigen::Vector3d(c.x(), c.y(), g + trunk + crown), crown, 0.12f);
+        k.mean_free_path = static_cast<float>(sensor_.vegetation_mean_free_path_m);  // foliage
         if (add(StructureKind::Tree, {t, k}, road)) break;
       }
     }
@@ -174,8 +186,9 @@ class RoadsideBuilder {
       const Path::Sample at = road.centre.at(s);
       const Eigen::Vector2d c = at.p + side * (rs.frontage_m + rng_.uniform(0, 15)) * leftOf(at.heading);
       const double r = rng_.uniform(0.6, 1.8);
-      add(StructureKind::Bush, {Solid::sphere(Eigen::Vector3d(c.x(), c.y(), w_.ground->height(c) + 0.3 * r), r, 0.15f)},
-          road);
+      Solid bush = Solid::sphere(Eigen::Vector3d(c.x(), c.y(), w_.ground->height(c) + 0.3 * r), r, 0.15f);
+      bush.mean_free_path = static_cast<float>(sensor_.vegetation_mean_free_path_m);
+      add(StructureKind::Bush, {bush}, road);
     }
   }
 
@@ -219,6 +232,9 @@ class RoadsideBuilder {
 
   World& w_;
   Rng rng_;
+  const SensorSpec& sensor_;
+  uint64_t fence_key_;
+  uint64_t walls_ = 0;
 };
 
 }  // namespace
@@ -279,7 +295,7 @@ World buildWorld(const Scenario& scenario) {
   if (scenario.ego.path.route) w.routes.push_back(w.pathOf(scenario.ego.path));
   for (const TrafficSpec& t : scenario.traffic)
     if (t.path.route) w.routes.push_back(w.pathOf(t.path));
-  RoadsideBuilder builder(w, streamKey({scenario.seed, 2}));
+  RoadsideBuilder builder(w, streamKey({scenario.seed, 2}), scenario.sensor, streamKey({scenario.seed, 9}));
   for (const Road& r : w.roads) builder.build(r);
   w.grid = std::make_unique<SolidGrid>(builder.solids);
   return w;

@@ -32,6 +32,8 @@ class ConfigSection {
     return v;
   }
   bool has(const std::string& key) const;
+  // The keys of this section, in file order (for maps whose keys are names, e.g. classes).
+  std::vector<std::string> keys() const;
   ConfigSection section(const std::string& key);
   // Throws ConfigError for every key of this section that was never read.
   void finish() const;
@@ -50,7 +52,18 @@ class ConfigSection {
   std::shared_ptr<std::set<std::string>> read_;
 };
 
-// Loads a YAML file; throws ConfigError naming the file when it is missing or not YAML.
+// The shipped config's path relative to the source tree, and every tool's default --config.
+inline constexpr const char* kDefaultConfig = "config/dlslot.yaml";
+
+// The config file to load for `given` (a --config value). Any path other than the default is
+// used as given. For the default: $DLSLOT_CONFIG when set, else config/dlslot.yaml in the working
+// directory, else the one of the install (<prefix>/share/dlslot/, next to the executable's bin/)
+// or of the source tree the binaries were built from. So a binary works from any directory.
+// Throws ConfigError saying where it looked.
+std::string findConfigFile(const std::string& given = kDefaultConfig);
+
+// Loads a YAML file (found with findConfigFile and named on stderr); throws ConfigError naming
+// the file when it is missing or not YAML.
 ConfigSection loadConfig(const std::string& file);
 
 // Channel names, one place (config section `channels`).

@@ -22,6 +22,13 @@ std::vector<int> solveAssignment(const Eigen::MatrixXd& cost);
 // columns only connect through admissible pairs, so each connected component of them is solved
 // on its own (exactly the same answer as one big problem, and most components of a traffic
 // scene are a single trajectory and its detection). Costs of admissible pairs must be finite.
-std::vector<int> solveGatedAssignment(const Eigen::MatrixXd& cost, const Admissible& admissible);
+//
+// Objective::LeastCost instead leaves a pair unmatched when that is cheaper: it minimises the
+// summed cost of the matched admissible pairs, an unmatched row or column costing 0, so only
+// admissible pairs of negative cost (a gain) are worth matching. Used where matching the most
+// pairs would chain wrong matches through a crowd when some of its members were not detected.
+enum class Objective { MostPairs, LeastCost };
+std::vector<int> solveGatedAssignment(const Eigen::MatrixXd& cost, const Admissible& admissible,
+                                      Objective objective = Objective::MostPairs);
 
 }  // namespace dlslot

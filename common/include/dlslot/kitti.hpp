@@ -57,6 +57,31 @@ struct LabelRow {
 std::vector<LabelRow> readTrackingLabels(const std::string& path);  // 17 or 18 fields a line
 void writeTrackingLabels(const std::string& path, const std::vector<LabelRow>& rows);
 
+// The left colour camera's image (image_02), where KITTI scores results; most tracking sequences
+// are 1242 x 375 (a few are 1224 x 370 or 1238 x 374).
+struct ImageSize {
+  double width = 1242, height = 375;
+};
+// Where a box appears in image_02: what a KITTI results row needs besides the 3-D box.
+struct ImageBox {
+  Eigen::Vector4d bbox2d = Eigen::Vector4d::Zero();     // left top right bottom, clipped to [0, w-1] x [0, h-1]
+  Eigen::Vector4d unclipped = Eigen::Vector4d::Zero();  // the same before clipping to the image
+  double alpha = 0;  // observationAngle()
+};
+// KITTI's alpha: rotation_y - atan2(x, z) of the box position, wrapped to (-pi, pi].
+double observationAngle(const CameraBox& box);
+// The 8 corners projected with P2 (the edges cut at a near plane 0.1 m in front of the camera, so
+// a box partly behind it gets the image of its visible part). nullopt when the box is not in the
+// image: all of it behind the camera, or its projection entirely outside. Throws
+// std::invalid_argument when the calibration has no P2.
+std::optional<ImageBox> projectToImage(const CameraBox& box, const Calib& calib, const ImageSize& image = {});
+// One KITTI tracking results row for a box in the lidar frame: frame, track id (box.id), type,
+// truncated 0, occluded 0, alpha, 2-D box, the camera box, score (box.score). nullopt when the box
+// is not in the image: the devkit scores only what the camera sees, so such rows must not be written.
+std::optional<LabelRow> resultRow(int frame, const Box& box_lidar, const Calib& calib, const ImageSize& image = {});
+// The same for a row whose 3-D box is already in the camera frame: fills bbox2d and alpha from row.box.
+std::optional<LabelRow> resultRow(LabelRow row, const Calib& calib, const ImageSize& image = {});
+
 // The comma-separated detection format: frame,type,x1,y1,x2,y2,score,h,w,l,x,y,z,rot_y,alpha
 // with type 1 Pedestrian, 2 Car, 3 Cyclist.
 std::vector<LabelRow> readCsvDetections(const std::string& path);
@@ -92,7 +117,7 @@ std::vector<double> readTimes(const std::string& path);
 // odometry root (holding sequences/); which one is detected from what exists.
 struct SequencePaths {
   enum class Layout { Tracking, Odometry } layout = Layout::Tracking;
-  std::string velodyne_dir;
+  std::string velodyne_dir;     // "" for a tracking sequence without scans (labels, calib, detections only)
   std::string calib;            // calib file
   std::string labels;           // label_02 file ("" when absent)
   std::string oxts;             // "" when absent
@@ -100,7 +125,7 @@ struct SequencePaths {
   bool poses_are_lidar = false; // tracking layout training/poses/SSSS.txt (simulator): T_world_lidar;
                                 // odometry layout poses/XX.txt: T_world_cam0 (converted with the calib)
   std::string times;            // odometry times.txt ("" when absent)
-  int num_frames = 0;           // number of .bin files (must be 000000..N-1)
+  int num_frames = 0;           // number of .bin files (must be 000000..N-1); without scans, set by SequenceReader
 };
 SequencePaths locateSequence(const std::string& root, const std::string& sequence);
 
@@ -122,6 +147,9 @@ class SequenceReader {
                  const std::vector<std::string>& detection_paths = {}, double min_detection_score = -1e300,
                  double frame_period_s = 0.1);
   int size() const { return paths_.num_frames; }
+  // False for a tracking sequence with labels/detections but no velodyne/: its frames have empty
+  // scans and it has as many frames as its labels and detections reach.
+  bool hasScans() const { return !paths_.velodyne_dir.empty(); }
   const SequencePaths& paths() const { return paths_; }
   const Calib& calib() const { return calib_; }
   bool hasGroundTruthPoses() const { return !gt_poses_.empty(); }

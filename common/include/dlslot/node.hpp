@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "dlslot/config.hpp"
+#include "dlslot/message_guard.hpp"
 #include "dlslot/process_status_t.hpp"
 #include "dlslot/timing_stats.hpp"
 
@@ -57,6 +58,12 @@ class ProcessStatus {
   explicit ProcessStatus(std::string name);
   void frameDone(int frame, double ms);  // one frame handled in `ms` milliseconds
   void decodeError(const std::string& channel);
+  // A message refused by the guard (message_guard.hpp): counted as "refused.CHANNEL.REASON" (and in
+  // decode_errors when it was malformed, errors when its content was), logged once per reason.
+  // `where` (e.g. "LOG: event 12: ") starts the logged line of an offline reader.
+  void refused(const std::string& channel, const Refusal& why, const std::string& where = "");
+  // The refused messages counted so far: "CHANNEL.REASON" -> count.
+  std::map<std::string, int64_t> refusals() const;
   void frameGap(const std::string& channel, int expected, int got);
   void timeout(const std::string& what);
   void error(const std::string& what);
@@ -90,10 +97,12 @@ class Node {
   // Calls `cb` with the raw bytes of every message on `channel` (LCM 1.3 takes no lambdas).
   using RawHandler = std::function<void(const lcm::ReceiveBuffer&)>;
   void subscribeRaw(const std::string& channel, RawHandler cb);
-  // Decodes and calls `cb`; a message that does not decode is counted and logged, never thrown.
+  // Decodes through the guard (decodeChecked) and calls `cb`; a refused message is counted and
+  // logged (ProcessStatus::refused), never thrown, and an exception from `cb` is counted too.
   template <class Msg>
   void subscribe(const std::string& channel, std::function<void(const Msg&)> cb);
-  // Same, for frame-indexed messages (a `frame` field): a jump in the frame index is a gap.
+  // Same, for frame-indexed messages (a `frame` field): a frame that is not new or too far ahead
+  // is refused (FrameOrder), a jump in the frame index is a gap.
   template <class Msg>
   void subscribeFrames(const std::string& channel, std::function<void(const Msg&)> cb);
   template <class Msg>
@@ -126,7 +135,7 @@ class Node {
   Channels channels_;
   ProcessStatus status_;
   std::vector<Timer> timers_;
-  std::map<std::string, int> last_frame_;
+  std::map<std::string, FrameOrder> frame_order_;
   std::list<RawHandler> handlers_;  // stable addresses: LCM keeps a pointer to each
   bool stop_ = false;
 };
@@ -144,21 +153,29 @@ template <class Msg>
 void Node::subscribe(const std::string& channel, std::function<void(const Msg&)> cb) {
   subscribeRaw(channel, [this, cb, channel](const lcm::ReceiveBuffer& rbuf) {
     Msg msg;
-    if (msg.decode(rbuf.data, 0, rbuf.data_size) < 0) {
-      status_.decodeError(channel);
+    if (const Refusal why = decodeChecked(rbuf.data, rbuf.data_size, &msg)) {
+      status_.refused(channel, why);
       return;
     }
-    cb(msg);
+    try {
+      cb(msg);
+    } catch (const std::exception& e) {
+      status_.refused(channel, {"handler_exception", e.what()});
+    }
   });
 }
 
 template <class Msg>
 void Node::subscribeFrames(const std::string& channel, std::function<void(const Msg&)> cb) {
   subscribe<Msg>(channel, [this, cb, channel](const Msg& msg) {
-    auto it = last_frame_.find(channel);
-    if (it != last_frame_.end() && msg.frame > it->second + 1)
-      status_.frameGap(channel, it->second + 1, msg.frame);
-    last_frame_[channel] = msg.frame;
+    FrameOrder& order = frame_order_[channel];
+    const int last = order.last();
+    if (const Refusal why = order.accept(msg.frame)) {
+      status_.refused(channel, why);
+      return;
+    }
+    // Frames are within [0, kMaxFrame] here, so neither `last + 1` nor the gap overflows.
+    if (last >= 0 && msg.frame > last + 1) status_.frameGap(channel, last + 1, msg.frame);
     cb(msg);
   });
 }

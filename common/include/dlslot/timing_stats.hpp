@@ -13,6 +13,7 @@ class TimingStats {
   double mean() const;
   double percentile(double p) const;  // p in [0, 100]; 0 when empty
   double max() const;
+  const std::vector<double>& samples() const { return samples_; }
 
  private:
   std::vector<double> samples_;

@@ -134,9 +134,22 @@ void VoxelLayer::nearest(const Eigen::Vector3f& q, int k, Neighbours& out) const
   range(q.x(), x0, x1);
   range(q.y(), y0, y1);
   range(q.z(), z0, z1);
+  // Per axis, the squared gap between q and each block of the range (at most 3 blocks: the
+  // block edge is >= the radius): a block whose box lies beyond the radius, or beyond the k-th
+  // best, is skipped before its lookup (the cube's corners mostly are).
+  float gap2[3][3];
+  const int64_t first[3] = {x0, y0, z0}, last[3] = {x1, y1, z1};
+  for (int a = 0; a < 3; ++a)
+    for (int64_t c = first[a]; c <= last[a]; ++c) {
+      const double lo = c * block_, v = q[a];
+      const double g = v < lo ? lo - v : (v > lo + block_ ? v - lo - block_ : 0.0);
+      gap2[a][c - first[a]] = static_cast<float>(g * g);
+    }
   for (int64_t bz = z0; bz <= z1; ++bz)
     for (int64_t by = y0; by <= y1; ++by)
       for (int64_t bx = x0; bx <= x1; ++bx) {
+        const float box2 = gap2[0][bx - x0] + gap2[1][by - y0] + gap2[2][bz - z0];
+        if (box2 >= radius2_ || (out.size() == k && box2 >= out.d2.back())) continue;
         const int b = index_.find(blockKey(bx, by, bz));
         if (b == BlockIndex::kMissing) continue;
         const size_t base = static_cast<size_t>(b) * capacity_;

@@ -54,7 +54,7 @@ void PointGrid::visit(int64_t x, int64_t y, int64_t z, const Eigen::Vector3f& q,
   // A cell whose nearest corner is beyond the k-th best (or the radius) cannot contribute.
   auto gap = [this](int64_t c, float v) {
     const double lo = c * cell_;
-    return std::max({lo - v, 0.0, v - (lo + cell_)});
+    return v < lo ? lo - v : (v > lo + cell_ ? v - lo - cell_ : 0.0);
   };
   const double gx = gap(x, q.x()), gy = gap(y, q.y()), gz = gap(z, q.z());
   const double box2 = gx * gx + gy * gy + gz * gz;

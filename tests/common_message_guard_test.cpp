@@ -100,6 +100,13 @@ TEST(MessageGuard, CountsAndStringLengthsAreCheckedBeforeLcmGenAllocates) {
   expectStructuralRefusals(sampleAssociations(4), kAssociationsStringAt, 8);
   expectStructuralRefusals(sampleSlotState(4), kSlotStringAt, 4);
   expectStructuralRefusals(sampleStatus(), kStatusStringAt, 8);
+  // A NUL inside a string, or none at its end (lcm-gen would not encode it back).
+  Bytes b = encode(sampleScan(4));
+  b[kScanStringAt + 4 + 1] = 0;
+  EXPECT_EQ(check<point_cloud_t>(b).reason, "bad_string");
+  b = encode(sampleScan(4));
+  b[kScanStringAt + 4 + 4] = 'x';
+  EXPECT_EQ(check<point_cloud_t>(b).reason, "bad_string");
   // Another type's fingerprint.
   EXPECT_EQ(check<odometry_t>(encode(sampleScan(1))).reason, "fingerprint");
 }

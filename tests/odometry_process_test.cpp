@@ -69,8 +69,9 @@ TEST(OdometryProcess, BehindThePlayerOnASimulatedSequence) {
   lcm::LCM lcm;
   ASSERT_TRUE(lcm.good());
   Listener listen;
-  lcm.subscribe("ODOMETRY", &Listener::onOdometry, &listen);
-  lcm.subscribe("PROCESS_STATUS", &Listener::onStatus, &listen);
+  Subscriptions subs(lcm);
+  subs.subscribe("ODOMETRY", &Listener::onOdometry, &listen);
+  subs.subscribe("PROCESS_STATUS", &Listener::onStatus, &listen);
   ASSERT_TRUE(handleUntil(lcm, [&] { return listen.has_status; }, 10.0)) << odometry.output();
 
   ChildProcess player({bin("dlslot-player"), "--config", config(), "--kitti", dir + "/sim", "--sequence", "0000",
@@ -113,8 +114,9 @@ TEST(OdometryProcess, FaultsDoNotStopIt) {
   lcm::LCM lcm;
   ASSERT_TRUE(lcm.good());
   Listener listen;
-  lcm.subscribe("ODOMETRY", &Listener::onOdometry, &listen);
-  lcm.subscribe("PROCESS_STATUS", &Listener::onStatus, &listen);
+  Subscriptions subs(lcm);
+  subs.subscribe("ODOMETRY", &Listener::onOdometry, &listen);
+  subs.subscribe("PROCESS_STATUS", &Listener::onStatus, &listen);
   ASSERT_TRUE(handleUntil(lcm, [&] { return listen.has_status; }, 10.0)) << odometry.output();
 
   const odometry::test::Scene street = odometry::test::street();

@@ -88,7 +88,12 @@ TEST(PipelineProcess, EveryFrameOnEveryChannelAndMetricsWithinBounds) {
   for (const auto& s : status) last[s.name] = s;
   for (const std::string p : {"player", "odometry", "tracker", "backend", "renderer"}) {
     ASSERT_TRUE(last.count(p)) << p;
+#ifdef __SANITIZE_ADDRESS__
+    // ./dlslot test --sanitize: several times slower, so inputs may miss their time limits.
+    EXPECT_EQ(last[p].decode_errors + last[p].frame_gaps, 0) << p << ": " << last[p].last_warning;
+#else
     EXPECT_EQ(last[p].decode_errors + last[p].frame_gaps + last[p].timeouts, 0) << p << ": " << last[p].last_warning;
+#endif
   }
   // Outputs and metrics.
   for (const std::string f : {"metrics.json", "report.md", "trajectory_slot_kitti.txt", "trajectory_odometry_kitti.txt",

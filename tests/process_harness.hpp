@@ -4,6 +4,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <gtest/gtest.h>
@@ -15,6 +16,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -48,6 +50,8 @@ class ChildProcess {
   ChildProcess(std::vector<std::string> argv, std::string log_path) : log_(std::move(log_path)) {
     pid_ = fork();
     if (pid_ == 0) {
+      // A test that dies (a failed assertion, a sanitizer abort) takes its children with it.
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
       int fd = open(log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       dup2(fd, 1);
       dup2(fd, 2);
@@ -106,6 +110,38 @@ class ChildProcess {
   std::string log_;
   bool exited_ = false;
   int status_ = 0;
+};
+
+// Typed subscriptions for tests, in place of lcm-cpp's LCM::subscribe(channel, &Class::method,
+// object): those hand LCM's dispatch a C++ object it calls back through (UBSan: "member access
+// within address ... which does not point to an object of type 'LCMMHSubscription'") and stay
+// registered until the LCM is destroyed, after the handler object may have gone. Here messages
+// are decoded through the guard (refused ones skipped), and every subscription is removed when
+// this object goes: declare it after the LCM and the handler object.
+class Subscriptions {
+ public:
+  explicit Subscriptions(lcm::LCM& lcm) : lcm_(lcm) {}
+  Subscriptions(const Subscriptions&) = delete;
+  Subscriptions& operator=(const Subscriptions&) = delete;
+  ~Subscriptions() {
+    for (lcm::Subscription* s : subs_) lcm_.unsubscribe(s);
+  }
+  template <class Msg, class Handler>
+  void subscribe(const std::string& channel,
+                 void (Handler::*method)(const lcm::ReceiveBuffer*, const std::string&, const Msg*), Handler* h) {
+    raw_.push_back(std::make_unique<Raw>([method, h](const lcm::ReceiveBuffer* rbuf, const std::string& ch) {
+      Msg m;
+      if (!decodeChecked(rbuf->data, rbuf->data_size, &m)) (h->*method)(rbuf, ch, &m);
+    }));
+    subs_.push_back(lcm_.subscribeFunction<Raw*>(channel, &Subscriptions::dispatch, raw_.back().get()));
+  }
+
+ private:
+  using Raw = std::function<void(const lcm::ReceiveBuffer*, const std::string&)>;
+  static void dispatch(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Raw* raw) { (*raw)(rbuf, channel); }
+  lcm::LCM& lcm_;
+  std::vector<std::unique_ptr<Raw>> raw_;
+  std::vector<lcm::Subscription*> subs_;
 };
 
 // Handles LCM messages until pred() holds or timeout_s passes; returns pred().

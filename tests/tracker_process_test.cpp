@@ -69,8 +69,9 @@ TEST(TrackerProcess, LockstepFramesWithFaults) {
   lcm::LCM lcm;
   ASSERT_TRUE(lcm.good());
   Listener listen;
-  lcm.subscribe("ASSOCIATIONS", &Listener::onAssociations, &listen);
-  lcm.subscribe("PROCESS_STATUS", &Listener::onStatus, &listen);
+  Subscriptions subs(lcm);
+  subs.subscribe("ASSOCIATIONS", &Listener::onAssociations, &listen);
+  subs.subscribe("PROCESS_STATUS", &Listener::onStatus, &listen);
   ASSERT_TRUE(handleUntil(lcm, [&] { return listen.has_status; }, 10.0)) << tracker.output();
 
   // A car at 10 m/s in the world; the ego vehicle drives and turns.

@@ -67,6 +67,11 @@ class Cursor {
     if (static_cast<size_t>(len) > left())
       return fail("bad_string", std::string(field) + ": string length " + std::to_string(len) + ", " +
                                     std::to_string(left()) + " bytes left");
+    // One NUL, at the end: lcm-gen's encoder writes a string up to its first NUL, so one with a NUL
+    // inside would not encode back to what was decoded (found by fuzz_msg_*).
+    const void* nul = std::memchr(b_ + pos_, 0, static_cast<size_t>(len));
+    if (nul != b_ + pos_ + len - 1)
+      return fail("bad_string", std::string(field) + ": expected one NUL, at the end of the string");
     pos_ += static_cast<size_t>(len);
     return true;
   }

@@ -62,10 +62,14 @@ void solveLowerTransposed(const double* L, int n, int ldl, double* B, int m, int
 }
 
 void subtractOuter(const double* X, int n, int k, int ldx, double* S, int lds) {
+  // Nothing to subtract (and an empty X may have no storage: Eigen's kernel would bind a
+  // reference to its null data, UBSan in ./dlslot test --sanitize).
+  if (n == 0 || k == 0) return;
   Map(S, n, n, Stride(lds)).selfadjointView<Eigen::Lower>().rankUpdate(ConstMap(X, n, k, Stride(ldx)), -1.0);
 }
 
 void subtractProductTN(const double* A, int k, int m, int lda, const double* B, int n, int ldb, double* C, int ldc) {
+  if (k == 0 || m == 0 || n == 0) return;  // as subtractOuter
   Map(C, m, n, Stride(ldc)).noalias() -= ConstMap(A, k, m, Stride(lda)).transpose() * ConstMap(B, k, n, Stride(ldb));
 }
 

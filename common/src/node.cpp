@@ -18,6 +18,14 @@ namespace dlslot {
 
 // ---------------- CommandLine ----------------
 
+std::vector<std::string> splitList(const std::string& value) {
+  std::vector<std::string> out;
+  std::stringstream is(value);
+  for (std::string item; std::getline(is, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
 CommandLine::CommandLine(std::string program, std::string summary)
     : program_(std::move(program)), summary_(std::move(summary)) {}
 

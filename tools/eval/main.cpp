@@ -36,14 +36,6 @@ struct Options {
   bool allow_missing_truth = false, quiet = false;
 };
 
-std::vector<std::string> splitList(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream is(s);
-  for (std::string item; std::getline(is, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 Channels readChannels(const std::string& config) {
   Channels channels;
   // The default config is optional (the built-in channel names are the shipped ones); a config

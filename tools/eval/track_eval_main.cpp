@@ -32,14 +32,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::vector<std::string> splitList(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream is(s);
-  for (std::string item; std::getline(is, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 // Every sequence with a label file under ROOT/training/label_02 (or ROOT/label_02).
 std::vector<std::string> sequencesIn(const std::string& root) {
   fs::path labels = fs::path(root) / "training" / "label_02";

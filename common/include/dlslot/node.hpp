@@ -20,6 +20,9 @@
 
 namespace dlslot {
 
+// The items of a comma-separated option value ("0000,0002" -> {"0000", "0002"}; empty items dropped).
+std::vector<std::string> splitList(const std::string& value);
+
 // A small option parser: --name VALUE options, --flag switches, --help.
 class CommandLine {
  public:

@@ -335,14 +335,20 @@ std::optional<LabelRow> resultRow(LabelRow row, const Calib& calib, const ImageS
   return row;
 }
 
-std::optional<LabelRow> resultRow(int frame, const Box& box_lidar, const Calib& calib, const ImageSize& image) {
+LabelRow unprojectedRow(int frame, const Box& box_lidar, const Calib& calib) {
   LabelRow row;
   row.frame = frame;
   row.track_id = box_lidar.id;
   row.type = box_lidar.type;
+  row.alpha = -10;
+  row.bbox2d = Eigen::Vector4d::Constant(-1);
   row.box = lidarToCamera(box_lidar, calib);
   row.score = box_lidar.score;
-  return resultRow(std::move(row), calib, image);
+  return row;
+}
+
+std::optional<LabelRow> resultRow(int frame, const Box& box_lidar, const Calib& calib, const ImageSize& image) {
+  return resultRow(unprojectedRow(frame, box_lidar, calib), calib, image);
 }
 
 std::vector<LabelRow> readCsvDetections(const std::string& path) {

@@ -40,21 +40,13 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
   TrajectoryAssociator associator(config);
   OfflineResult out;
   auto write = [&](int frame, const Box& box) {
-    if (auto row = kitti::resultRow(frame, box, reader.calib())) {
-      out.tracks.push_back(*row);
+    kitti::LabelRow row = kitti::unprojectedRow(frame, box, reader.calib());
+    if (auto projected = kitti::resultRow(row, reader.calib())) {
+      out.tracks.push_back(std::move(*projected));
       return;
     }
     ++out.outside_image;
-    if (!all_around) return;
-    kitti::LabelRow row;
-    row.frame = frame;
-    row.track_id = box.id;
-    row.type = box.type;
-    row.alpha = -10;
-    row.bbox2d = Eigen::Vector4d::Constant(-1);
-    row.box = kitti::lidarToCamera(box, reader.calib());
-    row.score = box.score;
-    out.tracks.push_back(row);
+    if (all_around) out.tracks.push_back(std::move(row));
   };
   int max_id = -1;
   for (int i = 0; i < reader.size(); ++i) {

@@ -110,7 +110,7 @@ int run(int argc, char** argv) {
   fs::create_directories(fs::path(out) / "data_all");
 
   // Score the classes the detection files hold (a class without detections would only score its
-  // labels as misses).
+  // labels as misses): those of the rows of the all-tracks run, which tracks every detection.
   KittiProtocolOptions options;
   options.min_iou = min_iou;
   std::set<std::string> detected;
@@ -123,9 +123,6 @@ int run(int argc, char** argv) {
     const std::string& s = sequences[i];
     if (!quiet) progress.update(static_cast<int>(i), "sequence " + s);
     const kitti::SequenceReader reader(root, s, detections, -1e300, frame_period);
-    for (int f = 0; f < reader.size(); ++f)
-      for (const Box& b : reader.read(f).detections)
-        if (const ClassPolicy* p = policyFor(cfg.associator.classes, b.type)) detected.insert(p->name);
     if (reader.paths().labels.empty()) throw std::invalid_argument(root + ": sequence " + s + " has no label file");
     std::string pose_source;
     const std::vector<Pose> ego = tracker::egoPosesFor(reader, s, poses, &pose_source);
@@ -145,6 +142,8 @@ int run(int argc, char** argv) {
     const tracker::OfflineResult r_all = tracker::associateSequence(reader, ego, sweep_cfg.associator, sweep_cfg.output);
     kitti::writeTrackingLabels((fs::path(out) / "data_all" / (s + ".txt")).string(), r_all.tracks);
     KittiSequence seq_all{s, seq.labels, r_all.tracks, seq.frames};
+    for (const kitti::LabelRow& row : r_all.tracks)
+      if (const ClassPolicy* p = policyFor(cfg.associator.classes, row.type)) detected.insert(p->name);
     options.classes.assign(detected.begin(), detected.end());
     per_sequence[s] = combine(evaluateKittiTracking({seq}, options), evaluateKittiTracking({seq_all}, options));
     all.push_back(std::move(seq));

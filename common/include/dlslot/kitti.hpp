@@ -79,6 +79,9 @@ std::optional<ImageBox> projectToImage(const CameraBox& box, const Calib& calib,
 // truncated 0, occluded 0, alpha, 2-D box, the camera box, score (box.score). nullopt when the box
 // is not in the image: the devkit scores only what the camera sees, so such rows must not be written.
 std::optional<LabelRow> resultRow(int frame, const Box& box_lidar, const Calib& calib, const ImageSize& image = {});
+// The same row without its image fields (2-D box -1, alpha -10, the devkit's "unknown"), for a box
+// the camera does not see: what a results file for labels all around the scan holds there.
+LabelRow unprojectedRow(int frame, const Box& box_lidar, const Calib& calib);
 // The same for a row whose 3-D box is already in the camera frame: fills bbox2d and alpha from row.box.
 std::optional<LabelRow> resultRow(LabelRow row, const Calib& calib, const ImageSize& image = {});
 

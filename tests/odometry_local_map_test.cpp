@@ -8,23 +8,10 @@
 #include <unordered_map>
 
 #include "odometry/local_map.hpp"
+#include "odometry_random_cloud.hpp"
 
 namespace dlslot::odometry {
 namespace {
-
-FeatureCloud randomCloud(int n, std::mt19937& rng, float extent) {
-  std::uniform_real_distribution<float> U(-extent, extent);
-  FeatureCloud c;
-  for (int i = 0; i < n; ++i) {
-    pcl::PointXYZI p;
-    p.x = U(rng);
-    p.y = U(rng);
-    p.z = 0.1f * U(rng);  // flat, like a street: many points share blocks
-    p.intensity = 0.0f;
-    c.push_back(p);
-  }
-  return c;
-}
 
 // The k nearest of `all` within radius, nearest first.
 std::vector<float> bruteForce(const std::vector<Eigen::Vector3f>& all, const Eigen::Vector3f& q, int k, float radius) {
@@ -44,7 +31,7 @@ TEST(OdometryLocalMap, NearestAgreesWithBruteForce) {
       Eigen::Isometry3f T = Eigen::Isometry3f::Identity();
       T.translation() = Eigen::Vector3f(0.7f * scan, -0.3f * scan, 0.0f);
       T.linear() = Eigen::AngleAxisf(0.2f * scan, Eigen::Vector3f::UnitZ()).toRotationMatrix();
-      layer.insert(randomCloud(4000, rng, 12.0f), T);
+      layer.insert(test::randomFlatCloud(4000, 12.0f, 0.1f, rng), T);
     }
     const std::vector<Eigen::Vector3f> all = layer.points();
     ASSERT_EQ(all.size(), layer.size());
@@ -86,7 +73,7 @@ TEST(OdometryLocalMap, RunningMeanPerVoxel) {
 TEST(OdometryLocalMap, CropKeepsExactlyThePointsWithinTheRadius) {
   std::mt19937 rng(11);
   VoxelLayer layer(0.4, 1.0);
-  layer.insert(randomCloud(20000, rng, 60.0f), Eigen::Isometry3f::Identity());
+  layer.insert(test::randomFlatCloud(20000, 60.0f, 0.1f, rng), Eigen::Isometry3f::Identity());
   const std::vector<Eigen::Vector3f> before = layer.points();
   const Eigen::Vector3d center(13.3, -7.1, 2.0);
   const double radius = 31.7;

@@ -6,28 +6,15 @@
 #include <random>
 
 #include "odometry/point_grid.hpp"
+#include "odometry_random_cloud.hpp"
 
 namespace dlslot::odometry {
 namespace {
 
-FeatureCloud cloudOf(int n, float extent, std::mt19937& rng) {
-  std::uniform_real_distribution<float> U(-extent, extent);
-  FeatureCloud c;
-  for (int i = 0; i < n; ++i) {
-    pcl::PointXYZI p;
-    p.x = U(rng);
-    p.y = U(rng);
-    p.z = 0.2f * U(rng);
-    p.intensity = static_cast<float>(i % 64);
-    c.push_back(p);
-  }
-  return c;
-}
-
 TEST(OdometryPointGrid, NearestAgreesWithBruteForce) {
   std::mt19937 rng(17);
   for (const auto& [cell, n, extent] : {std::tuple{0.5, 20000, 30.0f}, std::tuple{1.0, 800, 40.0f}, std::tuple{0.3, 50, 10.0f}}) {
-    const FeatureCloud cloud = cloudOf(n, extent, rng);
+    const FeatureCloud cloud = test::randomFlatCloud(n, extent, 0.2f, rng);
     PointGrid grid(cell);
     grid.build(cloud);
     std::uniform_real_distribution<float> U(-extent - 3.0f, extent + 3.0f);
@@ -62,7 +49,7 @@ TEST(OdometryPointGrid, EmptyAndRebuilt) {
   grid.nearest(Eigen::Vector3f::Zero(), 5, 25.0f, idx, d2);
   EXPECT_TRUE(idx.empty());
   std::mt19937 rng(1);
-  const FeatureCloud a = cloudOf(100, 5.0f, rng), b = cloudOf(3, 5.0f, rng);
+  const FeatureCloud a = test::randomFlatCloud(100, 5.0f, 0.2f, rng), b = test::randomFlatCloud(3, 5.0f, 0.2f, rng);
   grid.build(a);
   grid.build(b);  // nothing of a is left
   grid.nearest(Eigen::Vector3f::Zero(), 10, 1e6f, idx, d2);

@@ -12,8 +12,11 @@ ClearMot evaluateClearMot(const std::vector<TrackingFrame>& frames, const MatchC
   ClearMot m;
   std::map<int, int> previous;    // label id -> track id, matched in the previous frame
   std::map<int, int> last_match;  // label id -> track id it was last matched to, any frame
+  std::map<int, int> first_output;  // track id -> index of the first frame it was output in
   double distance_sum = 0, velocity_sq_sum = 0;
-  for (const TrackingFrame& f : frames) {
+  for (size_t index = 0; index < frames.size(); ++index) {
+    const TrackingFrame& f = frames[index];
+    for (const Object& h : f.tracks) first_output.emplace(h.box.id, static_cast<int>(index));
     const int nt = static_cast<int>(f.truth.size()), nh = static_cast<int>(f.tracks.size());
     std::vector<int> track_of(nt, -1);
     std::vector<bool> taken(nh, false);
@@ -55,6 +58,9 @@ ClearMot evaluateClearMot(const std::vector<TrackingFrame>& frames, const MatchC
       if (last != last_match.end() && last->second != h.box.id) ++m.idsw;
       last_match[g.box.id] = h.box.id;
       current[g.box.id] = h.box.id;
+      if (g.velocity && h.velocity)
+        m.velocities.push_back({static_cast<int>(index), g.box.type, g.dynamic,
+                                static_cast<int>(index) - first_output.at(h.box.id), *g.velocity, *h.velocity});
       if (g.dynamic && g.velocity && h.velocity) {
         velocity_sq_sum += (*g.velocity - *h.velocity).squaredNorm();
         ++m.velocity_pairs;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "tracking_frames.hpp"
+#include "velocity_breakdown.hpp"
 
 namespace dlslot::eval {
 
@@ -19,6 +20,8 @@ struct ClearMot {
   // Velocity error of matched labels that are dynamic and have a velocity on both sides.
   int velocity_pairs = 0;
   std::optional<double> velocity_rmse_mps;
+  // Every matched pair with a velocity on both sides, static labels included (for the breakdown).
+  std::vector<VelocityPair> velocities;
 };
 
 // `frames` in scan order, ignored tracks already removed (dropIgnoredTracks).

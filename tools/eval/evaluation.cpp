@@ -47,7 +47,9 @@ std::string assignVelocities(RunData& run, double dynamic_speed_mps) {
 
 TrackingMetrics trackingMetrics(std::vector<TrackingFrame> frames, const MatchCriterion& criterion) {
   dropIgnoredTracks(frames, criterion);
-  return {criterion, evaluateClearMot(frames, criterion), evaluateHota(frames, criterion)};
+  TrackingMetrics t{criterion, evaluateClearMot(frames, criterion), evaluateHota(frames, criterion), {}};
+  t.velocity_groups = breakdownVelocityErrors(t.clear.velocities, static_cast<int>(frames.size()));
+  return t;
 }
 
 }  // namespace

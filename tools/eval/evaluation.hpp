@@ -45,6 +45,7 @@ struct TrackingMetrics {
   MatchCriterion criterion;
   ClearMot clear;
   std::optional<Hota> hota;
+  std::vector<VelocityGroup> velocity_groups;  // the velocity error by age, class, motion, stretch
 };
 
 struct Metrics {

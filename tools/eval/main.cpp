@@ -352,6 +352,7 @@ int run(int argc, char** argv) {
       }
     }
     writeMetricsJson((out / "metrics.json").string(), metrics);
+    writeVelocityErrorsCsv((out / "velocity_errors.csv").string(), metrics);
     writeReport((out / "report.md").string(), metrics, plots);
   }
   if (!o.quiet) printSummary(std::cout, metrics);

@@ -142,6 +142,14 @@ Table kittiTable(const Metrics& m) {
   return t;
 }
 
+Table velocityTable(const TrackingMetrics& t) {
+  Table table({"by", "group", "pairs", "RMSE m/s", "mean m/s", "p90 m/s"});
+  for (const VelocityGroup& g : t.velocity_groups)
+    table.row({g.dimension, g.bin, std::to_string(g.pairs), cell(g.rmse_mps, "%.3f"), cell(g.mean_mps, "%.3f"),
+               cell(g.p90_mps, "%.3f")});
+  return table;
+}
+
 Table timingTable(const Metrics& m) {
   Table t({"module", "frames", "mean ms", "p95 ms", "max ms"});
   for (const auto& [module, s] : m.timing_ms)
@@ -199,6 +207,13 @@ std::string metricsJson(const Metrics& m) {
   for (const auto& [key, v] : trackingValues(m.tracking_iou)) kv.emplace_back("tracking_iou." + key, num(v));
   for (const auto& [cls, k] : m.kitti)
     for (const auto& [key, v] : kittiValues(k)) kv.emplace_back("tracking." + cls + "." + key, num(v));
+  if (m.tracking)
+    for (const VelocityGroup& g : m.tracking->velocity_groups) {
+      const std::string prefix = "velocity." + g.dimension + "." + g.bin + ".";
+      kv.emplace_back(prefix + "pairs", std::to_string(g.pairs));
+      kv.emplace_back(prefix + "rmse_mps", num(g.rmse_mps));
+      kv.emplace_back(prefix + "p90_mps", num(g.p90_mps));
+    }
   for (const auto& [module, s] : m.timing_ms) {
     kv.emplace_back("timing_ms." + module + ".mean", num(s.count() ? Opt(s.mean()) : std::nullopt));
     kv.emplace_back("timing_ms." + module + ".p95", num(s.count() ? Opt(s.percentile(95)) : std::nullopt));
@@ -235,6 +250,11 @@ std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plo
            "the IoU line, max(0, 1 - d / "
         << num(m.tracking->criterion.max_distance_m, "%g") << " m) of the centre distance d for the distance line.\n\n"
         << "Velocities: " << m.velocity_frame << ".\n\n";
+    if (!m.tracking->velocity_groups.empty())
+      out << "### Velocity error by track age (scans since first output), class, motion and stretch of the "
+             "sequence\n\n"
+          << velocityTable(*m.tracking).render()
+          << "\nAge, class and stretch rows: dynamic labels only, as the velocity RMSE; motion rows: both.\n\n";
   }
   if (!m.kitti.empty()) {
     out << "## Tracking, KITTI protocol (3-D IoU >= " << num(m.kitti.begin()->second.min_iou, "%g")
@@ -271,6 +291,19 @@ std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plo
     for (const std::string& p : plots) out << "![" << p << "](" << p << ")\n\n";
   }
   return out.str();
+}
+
+void writeVelocityErrorsCsv(const std::string& path, const Metrics& m) {
+  std::ostringstream out;
+  out << "frame_index,class,dynamic,track_age,truth_vx,truth_vy,track_vx,track_vy,error_mps\n";
+  if (m.tracking)
+    for (const VelocityPair& p : m.tracking->clear.velocities) {
+      char buf[256];
+      std::snprintf(buf, sizeof buf, "%d,%s,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f\n", p.frame_index, p.type.c_str(),
+                    p.dynamic ? 1 : 0, p.track_age, p.truth.x(), p.truth.y(), p.track.x(), p.track.y(), p.error());
+      out << buf;
+    }
+  writeText(path, out.str());
 }
 
 void writeReport(const std::string& path, const Metrics& m, const std::vector<std::string>& plots) {

@@ -22,6 +22,8 @@ std::string metricsJson(const Metrics& m);
 // The KITTI protocol's numbers of one class as (key, value) pairs, in metrics.json's order.
 std::vector<std::pair<std::string, std::optional<double>>> kittiValues(const KittiClassMetrics& k);
 void writeMetricsJson(const std::string& path, const Metrics& m);
+// One row per matched pair with a velocity on both sides (VelocityPair), for plots of your own.
+void writeVelocityErrorsCsv(const std::string& path, const Metrics& m);
 
 // report.md: tables of every metric, notes, and the plots (paths relative to the report).
 std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plots);

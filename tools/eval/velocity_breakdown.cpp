@@ -1,0 +1,68 @@
+#include "velocity_breakdown.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+namespace dlslot::eval {
+namespace {
+
+std::string ageBin(int age) {
+  if (age < 5) return "0-4";
+  if (age < 10) return "5-9";
+  if (age < 20) return "10-19";
+  return "20+";
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+VelocityGroup summarize(std::string dimension, std::string bin, std::vector<double> errors) {
+  VelocityGroup g{std::move(dimension), std::move(bin), static_cast<int>(errors.size()), {}, {}, {}};
+  if (errors.empty()) return g;
+  double sq = 0, sum = 0;
+  for (double e : errors) {
+    sq += e * e;
+    sum += e;
+  }
+  g.rmse_mps = std::sqrt(sq / errors.size());
+  g.mean_mps = sum / errors.size();
+  std::sort(errors.begin(), errors.end());
+  g.p90_mps = errors[std::min(errors.size() - 1, static_cast<size_t>(0.9 * errors.size()))];
+  return g;
+}
+
+}  // namespace
+
+std::vector<VelocityGroup> breakdownVelocityErrors(const std::vector<VelocityPair>& pairs, int num_frames) {
+  const int stretch = std::max(1, (num_frames + 9) / 10);
+  const auto frameBin = [&](int index) {
+    char buf[32];
+    const int first = index / stretch * stretch;
+    std::snprintf(buf, sizeof buf, "%03d-%03d", first, std::min(num_frames, first + stretch) - 1);
+    return std::string(buf);
+  };
+  // Ordered bins per dimension; std::map keeps classes and frame stretches sorted.
+  std::map<std::string, std::vector<double>> age, cls, motion, frames;
+  for (const VelocityPair& p : pairs) {
+    motion[p.dynamic ? "dynamic" : "static"].push_back(p.error());
+    if (!p.dynamic) continue;
+    age[ageBin(p.track_age)].push_back(p.error());
+    cls[lower(p.type)].push_back(p.error());
+    frames[frameBin(p.frame_index)].push_back(p.error());
+  }
+  std::vector<VelocityGroup> out;
+  for (const char* bin : {"0-4", "5-9", "10-19", "20+"})
+    if (age.count(bin)) out.push_back(summarize("age", bin, age[bin]));
+  for (auto& [bin, e] : cls) out.push_back(summarize("class", bin, std::move(e)));
+  for (const char* bin : {"dynamic", "static"})
+    if (motion.count(bin)) out.push_back(summarize("motion", bin, motion[bin]));
+  for (auto& [bin, e] : frames) out.push_back(summarize("frames", bin, std::move(e)));
+  return out;
+}
+
+}  // namespace dlslot::eval

@@ -102,6 +102,11 @@ TEST(EvalEgo, RelativePoseErrorOfAStretchedPath) {
   EXPECT_NEAR(r10->t_rmse_m, 1.0, 1e-12);
   EXPECT_EQ(r10->pairs, 40);
   EXPECT_FALSE(relativePoseError(est, gt, 50));  // no pair 50 frames apart
+  // Stamps 0.1 s apart: 1.1 m a scan against 1 m is 1 m/s too fast, over any span.
+  ASSERT_TRUE(r1->velocity_rmse_mps && r10->velocity_rmse_mps);
+  EXPECT_NEAR(*r1->velocity_rmse_mps, 1.0, 1e-9);
+  EXPECT_NEAR(*r10->velocity_rmse_mps, 1.0, 1e-9);
+  EXPECT_NEAR(*evaluateEgo(est, gt).velocity_rmse_mps, 1.0, 1e-9);
 }
 
 TEST(EvalEgo, RelativePoseErrorPairsFramesByIndexAcrossGaps) {

@@ -327,3 +327,47 @@ TEST(EvalVelocity, EvaluateComparesTheSystemsVelocityWithGroundTruthMotion) {
   EXPECT_NEAR(m.tracking->hota->hota, 1.0, 1e-12);
   EXPECT_NE(m.velocity_frame.find("world"), std::string::npos);
 }
+
+TEST(EvalTracking, VelocityErrorsAreBrokenDownByAgeClassMotionAndStretch) {
+  // One car tracked from frame 0, a van from frame 10, a parked car; 20 frames. The car's track is
+  // 1 m/s off along x, the van's 2 m/s, the parked car's 0.5 m/s.
+  std::vector<TrackingFrame> frames;
+  for (int t = 0; t < 20; ++t) {
+    TrackingFrame f;
+    f.frame = t;
+    auto add = [&](double x, double y, int id, const std::string& type, double v_truth, double v_track, bool dynamic) {
+      Object g = obj(x, y, id, type), h = obj(x, y, 100 + id, type);
+      g.velocity = Eigen::Vector2d(v_truth, 0);
+      g.dynamic = dynamic;
+      h.velocity = Eigen::Vector2d(v_track, 0);
+      f.truth.push_back(g);
+      f.tracks.push_back(h);
+    };
+    add(10, 0, 1, "Car", 10, 11, true);
+    if (t >= 10) add(20, 10, 2, "Van", 5, 7, true);
+    add(30, -10, 3, "Car", 0, 0.5, false);
+    frames.push_back(f);
+  }
+  const ClearMot m = evaluateClearMot(frames, kDistance);
+  EXPECT_EQ(m.velocities.size(), 50u);
+  EXPECT_EQ(m.velocity_pairs, 30);  // dynamic labels only
+  const auto groups = breakdownVelocityErrors(m.velocities, 20);
+  auto find = [&](const std::string& by, const std::string& bin) -> const VelocityGroup& {
+    for (const VelocityGroup& g : groups)
+      if (g.dimension == by && g.bin == bin) return g;
+    ADD_FAILURE() << by << " " << bin << " missing";
+    static VelocityGroup none;
+    return none;
+  };
+  // Ages 0-4: the car's frames 0-4 and the van's 10-14 (errors 1 and 2).
+  EXPECT_EQ(find("age", "0-4").pairs, 10);
+  EXPECT_NEAR(*find("age", "0-4").rmse_mps, std::sqrt((5 * 1.0 + 5 * 4.0) / 10), 1e-12);
+  EXPECT_EQ(find("age", "10-19").pairs, 10);  // the car's frames 10-19
+  EXPECT_NEAR(*find("age", "10-19").rmse_mps, 1.0, 1e-12);
+  EXPECT_NEAR(*find("class", "van").rmse_mps, 2.0, 1e-12);
+  EXPECT_EQ(find("class", "car").pairs, 20);  // the parked car is not dynamic
+  EXPECT_NEAR(*find("motion", "static").rmse_mps, 0.5, 1e-12);
+  EXPECT_EQ(find("motion", "dynamic").pairs, 30);
+  EXPECT_EQ(find("frames", "000-001").pairs, 2);
+  EXPECT_NEAR(*find("frames", "018-019").rmse_mps, std::sqrt((2 * 1.0 + 2 * 4.0) / 4), 1e-12);
+}

@@ -88,8 +88,8 @@ std::optional<Rpe> relativePoseError(const Trajectory& est, const Trajectory& gt
   requireSameFrames(est, gt);
   std::map<int, size_t> index;
   for (size_t i = 0; i < gt.size(); ++i) index[gt.frames[i]] = i;
-  double sum_t = 0, sum_r = 0;
-  int pairs = 0;
+  double sum_t = 0, sum_r = 0, sum_v = 0;
+  int pairs = 0, timed = 0;
   for (size_t i = 0; i < gt.size(); ++i) {
     const auto it = index.find(gt.frames[i] + delta);
     if (it == index.end()) continue;
@@ -101,9 +101,16 @@ std::optional<Rpe> relativePoseError(const Trajectory& est, const Trajectory& gt
     const double r = rotationAngle(E.linear()) * kRadToDeg;
     sum_r += r * r;
     ++pairs;
+    const double dt = gt.stamps.size() == gt.size() ? gt.stamps[j] - gt.stamps[i] : 0.0;
+    if (dt > 0) {
+      sum_v += E.translation().squaredNorm() / (dt * dt);
+      ++timed;
+    }
   }
   if (pairs == 0) return std::nullopt;
-  return Rpe{std::sqrt(sum_t / pairs), std::sqrt(sum_r / pairs), pairs};
+  Rpe rpe{std::sqrt(sum_t / pairs), std::sqrt(sum_r / pairs), pairs, std::nullopt};
+  if (timed > 0) rpe.velocity_rmse_mps = std::sqrt(sum_v / timed);
+  return rpe;
 }
 
 std::optional<SegmentErrors> segmentErrors(const Trajectory& est, const Trajectory& gt,
@@ -158,6 +165,7 @@ EgoMetrics evaluateEgo(const Trajectory& est, const Trajectory& gt) {
     m.rpe10_t_m = r->t_rmse_m;
     m.rpe10_r_deg = r->r_rmse_deg;
   }
+  if (const auto r = relativePoseError(est, gt, 5)) m.velocity_rmse_mps = r->velocity_rmse_mps;
   m.devkit = segmentErrors(est, gt, kDevkitLengths);
   if (m.devkit) {
     m.t_rel_pct = m.devkit->t_rel_pct;

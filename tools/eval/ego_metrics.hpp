@@ -26,9 +26,13 @@ std::vector<double> pathDistances(const Trajectory& gt);
 
 // Relative pose error over pairs of frames `delta` scan indices apart:
 // E = inv(inv(G_i) G_j) * inv(P_i) P_j; RMSE of |t(E)| (m) and of angle(R(E)) (deg).
+// velocity_rmse_mps: the same translation errors over the pairs' time spans (when the trajectory
+// has stamps): the ego's velocity error over `delta` scans, which every object velocity over
+// ground inherits.
 struct Rpe {
   double t_rmse_m = 0, r_rmse_deg = 0;
   int pairs = 0;
+  std::optional<double> velocity_rmse_mps;
 };
 std::optional<Rpe> relativePoseError(const Trajectory& est, const Trajectory& gt, int delta);
 
@@ -52,6 +56,7 @@ struct EgoMetrics {
   double path_length_m = 0;
   std::optional<double> ate_rmse_m, ate_unaligned_rmse_m;
   std::optional<double> rpe1_t_m, rpe1_r_deg, rpe10_t_m, rpe10_r_deg;
+  std::optional<double> velocity_rmse_mps;  // over 5 scans, as the backend's object velocities
   std::optional<double> t_rel_pct, r_rel_deg_per_100m, t_rel_short_pct, r_rel_short_deg_per_100m;
   std::optional<SegmentErrors> devkit, short_segments;
 };

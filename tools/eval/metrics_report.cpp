@@ -45,6 +45,7 @@ const std::vector<std::pair<std::string, std::function<Opt(const EgoMetrics&)>>>
       {"r_rel_deg_per_100m", [](const EgoMetrics& e) { return e.r_rel_deg_per_100m; }},
       {"t_rel_short_pct", [](const EgoMetrics& e) { return e.t_rel_short_pct; }},
       {"r_rel_short_deg_per_100m", [](const EgoMetrics& e) { return e.r_rel_short_deg_per_100m; }},
+      {"velocity_rmse_mps", [](const EgoMetrics& e) { return e.velocity_rmse_mps; }},
   };
   return keys;
 }
@@ -96,7 +97,8 @@ class Table {
 
 Table egoTable(const Metrics& m) {
   Table t({"source", "frames", "path m", "ATE m", "ATE unaligned m", "RPE1 t m", "RPE1 r deg", "RPE10 t m",
-           "RPE10 r deg", "t_rel %", "r_rel deg/100m", "t_rel 10-80m %", "r_rel 10-80m deg/100m"});
+           "RPE10 r deg", "t_rel %", "r_rel deg/100m", "t_rel 10-80m %", "r_rel 10-80m deg/100m",
+           "velocity err m/s"});
   for (const auto& [name, e] : m.ego) {
     const std::string label = name + (name == m.primary_source ? " (primary)" : "");
     if (!e) {
@@ -107,7 +109,7 @@ Table egoTable(const Metrics& m) {
            cell(e->ate_unaligned_rmse_m, "%.3f"), cell(e->rpe1_t_m, "%.4f"), cell(e->rpe1_r_deg, "%.4f"),
            cell(e->rpe10_t_m, "%.3f"), cell(e->rpe10_r_deg, "%.3f"), cell(e->t_rel_pct, "%.3f"),
            cell(e->r_rel_deg_per_100m, "%.4f"), cell(e->t_rel_short_pct, "%.3f"),
-           cell(e->r_rel_short_deg_per_100m, "%.4f")});
+           cell(e->r_rel_short_deg_per_100m, "%.4f"), cell(e->velocity_rmse_mps, "%.3f")});
   }
   return t;
 }
@@ -236,7 +238,7 @@ std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plo
   } else {
     out << egoTable(m).render() << "\n"
         << "ATE: RMSE of the position after SE(3) Umeyama alignment (unaligned: in the world of the first "
-           "scan, the ground truth anchored at the run's first frame when the run started later). RPE: RMSE over frame pairs 1 and 10 scans apart. t_rel / r_rel: KITTI devkit segments "
+           "scan, the ground truth anchored at the run's first frame when the run started later). RPE: RMSE over frame pairs 1 and 10 scans apart. Velocity err: the RMSE of the ego's velocity over 5 scans (the span of the backend's object velocities, whose error over ground includes it). t_rel / r_rel: KITTI devkit segments "
            "of 100..800 m starting every 10 frames (and 10..80 m), poses in the lidar frame.\n\n";
   }
   out << "## Tracking (bird's-eye view, each scan's lidar frame)\n\n";

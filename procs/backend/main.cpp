@@ -96,6 +96,7 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   SlidingWindow window(config);
   TimingStats total, solve, marginalize;
   int frames = 0, missing_odometry = 0, missing_associations = 0;
+  int64_t landmarks = 0, moving = 0, switched = 0;  // summed over frames
   std::map<int, slot_state_t> states;
   std::map<int, int> inputs_left;  // frame -> its input events not yet copied to the output
   for (const Joiner::Joined& j : joiner.flush()) {
@@ -106,6 +107,8 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
     total.add(result.stats.total_ms);
     solve.add(result.stats.solve_ms);
     marginalize.add(result.stats.marginalize_ms);
+    for (const TrackEstimate& e : result.tracks) (e.dynamic ? moving : landmarks) += 1;
+    switched += result.static_to_dynamic;
     states[j.frame] = toMsg(result, toString(config.mode));
     inputs_left[j.frame] = (j.a ? 1 : 0) + (j.b ? 1 : 0);
   }
@@ -147,6 +150,10 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   for (const auto& [what, n] : guard.refusals()) std::printf("  refused %s: %lld\n", what.c_str(), static_cast<long long>(n));
   std::printf("  total %.2f ms mean, %.2f p95; solve %.2f mean; marginalize %.2f mean\n", total.mean(),
               total.percentile(95), solve.mean(), marginalize.mean());
+  // What the objects give the ego: landmarks and moving objects in the graph per frame.
+  std::printf("  objects in the graph per frame: %.1f static landmarks, %.1f moving; %lld landmarks turned dynamic\n",
+              frames ? double(landmarks) / frames : 0.0, frames ? double(moving) / frames : 0.0,
+              static_cast<long long>(switched));
   return 0;
 }
 

@@ -18,6 +18,7 @@
 #include "backend/observation_factor.hpp"
 #include "backend/odometry_factor.hpp"
 #include "backend/pose_change_factor.hpp"
+#include "backend/vehicle_motion_factor.hpp"
 #include "backend/pose_manifold.hpp"
 #include "backend_scene.hpp"
 
@@ -221,6 +222,30 @@ TEST(BackendFactors, ConstantVelocityResidualAndJacobians) {
   const Eigen::VectorXd r = residual(f, {toBlock(planarPose(1, 0, 0)), toBlock(planarPose(1.2, 0, 0))});
   EXPECT_NEAR(r[0], 0.2, 1e-12);
   EXPECT_NEAR(r.norm(), 0.2, 1e-12);
+}
+
+TEST(BackendFactors, VehicleMotionResidualAndJacobians) {
+  std::mt19937 rng(9);
+  for (int i = 0; i < 10; ++i) {
+    const Pose c = randomPose(rng, 1.0, 0.3);
+    VehicleMotionFactor f(randomSqrtInfo(rng));
+    expectJacobiansMatchNumeric(f, {toBlock(c)});
+  }
+  // Sigmas lateral 0.1 m, vertical 0.2 m, roll 0.01, pitch 0.02 rad. Forward motion and yaw cost
+  // nothing; sideways and vertical motion, roll and pitch are whitened by their sigmas.
+  const auto f = std::unique_ptr<ceres::CostFunction>(VehicleMotionFactor::Create(Eigen::Vector4d(0.1, 0.2, 0.01, 0.02)));
+  const auto& vm = static_cast<const VehicleMotionFactor&>(*f);
+  Pose forward_turning = planarPose(2.5, 0, 0.05);
+  EXPECT_LT(residual(vm, {toBlock(forward_turning)}).norm(), 1e-12);
+  const Eigen::VectorXd r = residual(vm, {toBlock(planarPose(2.5, 0.05, 0))});
+  EXPECT_NEAR(r[1], 0.5, 1e-12);  // 0.05 m sideways / 0.1
+  EXPECT_NEAR(r.norm(), 0.5, 1e-12);
+  Pose climbing = Pose::Identity();
+  climbing.translation() = Eigen::Vector3d(2.5, 0, 0.1);
+  climbing.linear() = Eigen::AngleAxisd(0.002, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const Eigen::VectorXd rc = residual(vm, {toBlock(climbing)});
+  EXPECT_NEAR(rc[2], 0.5, 1e-12);  // 0.1 m up / 0.2
+  EXPECT_NEAR(rc[4], 0.1, 1e-9);   // 0.002 rad of pitch / 0.02
 }
 
 TEST(BackendFactors, MarginalizationPriorResidualJacobianAndLinearization) {

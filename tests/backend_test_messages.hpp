@@ -18,7 +18,11 @@ inline odometry_t odometryMsg(const BackendInput& in) {
   o.status = in.frame == 0 ? odometry_t::STATUS_FIRST_FRAME : odometry_t::STATUS_OK;
   o.pose = toMsg(in.odometry->pose);
   o.delta = toMsg(in.odometry->delta);
-  toMsg(Matrix6d(Matrix6d::Identity() * 1e-4), o.covariance);
+  // Like the odometry's scan-to-map covariance: optimistic (2 mm, 0.1 mrad), which the
+  // backend scales by odometry_covariance_scale.
+  Matrix6d covariance = Matrix6d::Zero();
+  covariance.diagonal() << 4e-6, 4e-6, 4e-6, 1e-8, 1e-8, 1e-8;
+  toMsg(covariance, o.covariance);
   return o;
 }
 

@@ -61,6 +61,18 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   c.pose_change_sigma = readSigmas(s, "pose_change_sigma");
   c.constant_velocity_sigma = readSigmas(s, "constant_velocity_sigma");
   c.first_pose_sigma = readSigmas(s, "first_pose_sigma");
+  s.get("observation_sigma_growth_per_m", c.observation_sigma_growth_per_m);
+  {
+    std::vector<double> v;
+    s.get("vehicle_motion_sigma", v);
+    if (v.size() != 4 || !(v[0] > 0 && v[1] > 0 && v[2] > 0 && v[3] > 0))
+      throw ConfigError(s.file() + ": " + s.path() +
+                        ".vehicle_motion_sigma: expected 4 standard deviations > 0 [lateral m, vertical m, roll rad, "
+                        "pitch rad]");
+    c.vehicle_motion_sigma = Eigen::Vector4d(v[0], v[1], v[2], v[3]);
+  }
+  s.get("vehicle_types", c.vehicle_types);
+  require(c.observation_sigma_growth_per_m >= 0.0, s, "observation_sigma_growth_per_m", "a number >= 0 (1/m)");
   s.get("degraded_odometry_scale", c.degraded_odometry_scale);
   require(c.degraded_odometry_scale >= 1.0, s, "degraded_odometry_scale", "a number >= 1");
   s.get("use_odometry_covariance", c.use_odometry_covariance);

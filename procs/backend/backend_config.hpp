@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "backend/se3.hpp"
 #include "dlslot/config.hpp"
@@ -30,6 +31,15 @@ struct BackendConfig {
   Vector6 pose_change_sigma = (Vector6() << 0.02, 0.02, 0.02, 0.005, 0.005, 0.005).finished();
   Vector6 constant_velocity_sigma = (Vector6() << 0.05, 0.03, 0.02, 0.005, 0.005, 0.01).finished();
   Vector6 first_pose_sigma = (Vector6() << 1e-3, 1e-3, 1e-3, 1e-4, 1e-4, 1e-4).finished();
+  // The vehicle motion prior on every pose change of a vehicle (vehicle_motion_factor.hpp):
+  // sigmas of its lateral and vertical translation (m) and roll and pitch (rad) per frame, and
+  // the classes it applies to.
+  Eigen::Vector4d vehicle_motion_sigma = Eigen::Vector4d(0.02, 0.02, 0.002, 0.002);
+  std::vector<std::string> vehicle_types = {"Car", "Van", "Truck", "Tram", "Cyclist"};
+  // A detector's box position error grows with range (fewer points on the object): the
+  // translation sigmas of (landmark) observations are the ones above times (1 + this x range in
+  // m); 0 keeps them constant.
+  double observation_sigma_growth_per_m = 0.0;
   // Odometry sigmas are multiplied by this when the odometry fell back to a prediction or
   // did not arrive (then the pose is predicted with constant velocity).
   double degraded_odometry_scale = 10.0;

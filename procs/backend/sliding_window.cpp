@@ -12,6 +12,7 @@
 #include "backend/observation_factor.hpp"
 #include "backend/odometry_factor.hpp"
 #include "backend/pose_change_factor.hpp"
+#include "backend/vehicle_motion_factor.hpp"
 
 namespace dlslot::backend {
 namespace {
@@ -110,13 +111,19 @@ void SlidingWindow::addEgoFrame(const BackendInput& in) {
     return;
   }
   Matrix6 S = sqrtInformation(config_.odometry_sigma);
-  if (have_odometry && config_.use_odometry_covariance) {
+  const bool degraded = !have_odometry || !in.odometry->ok;
+  if (degraded) {
+    // A missing or fallen-back odometry: the constant-velocity prediction with the configured
+    // sigmas times degraded_odometry_scale. Not the message's covariance: a fallback publishes
+    // its own wide placeholder (1 m), and scaled again it let moving objects alone, which
+    // cannot fix the ego's velocity, push a stopped ego along at 4 m/s.
+    S /= config_.degraded_odometry_scale;
+  } else if (config_.use_odometry_covariance) {
     Eigen::LLT<Matrix6> llt(in.odometry->covariance);
     // S = L^-1 with Sigma = L L^T gives S^T S = Sigma^-1.
     if (llt.info() == Eigen::Success && in.odometry->covariance.allFinite())
       S = llt.matrixL().solve(Matrix6::Identity()) / config_.odometry_covariance_scale;
   }
-  if (!have_odometry || !in.odometry->ok) S /= config_.degraded_odometry_scale;
   addFactor(OdometryFactor::Create(delta, S), false, {x_prev, x});
 }
 
@@ -150,11 +157,16 @@ void SlidingWindow::addObservations(const BackendInput& in) {
 
 std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track) const {
   std::vector<TimedPosition> positions;
+  double range_sum = 0;
   for (const auto& [f, obs] : track.observations) {
     const EgoFrame* ego = findFrame(f);
-    if (ego) positions.push_back({1e-6 * static_cast<double>(ego->utime), fromBlock(ego->pose->data()) * obs.b.translation()});
+    if (!ego) continue;
+    positions.push_back({1e-6 * static_cast<double>(ego->utime), fromBlock(ego->pose->data()) * obs.b.translation()});
+    range_sum += obs.b.translation().norm();
   }
-  return fitSpeed(positions, 0.5 * (config_.observation_sigma[0] + config_.observation_sigma[1]));
+  // The boxes' noise at their mean range.
+  const double range = positions.empty() ? 0.0 : range_sum / positions.size();
+  return fitSpeed(positions, 0.5 * (config_.observation_sigma[0] + config_.observation_sigma[1]) * noiseGrowth(range));
 }
 
 void SlidingWindow::startTrack(Track& track, int frame) {
@@ -171,12 +183,18 @@ void SlidingWindow::addTrackObservation(Track& track, int frame) {
   Observation& obs = track.observations.at(frame);
   double* x = findFrame(frame)->pose->data();
   const Pose X = fromBlock(x);
+  // The translation sigmas grow with the box's range.
+  const double growth = noiseGrowth(obs.b.translation().norm());
+  const auto sigmas = [growth](Vector6 sigma) {
+    sigma.head<3>() *= growth;
+    return sigma;
+  };
   if (track.model == TrackModel::kStatic) {
-    addFactor(LandmarkObservationFactor::Create(obs.b, sqrtInformation(config_.landmark_sigma)), true,
+    addFactor(LandmarkObservationFactor::Create(obs.b, sqrtInformation(sigmas(config_.landmark_sigma))), true,
               {x, track.landmark->data()});
   } else {
     extendChain(track, frame, X * obs.b);
-    addFactor(ObservationFactor::Create(obs.b, sqrtInformation(config_.observation_sigma)), true,
+    addFactor(ObservationFactor::Create(obs.b, sqrtInformation(sigmas(config_.observation_sigma))), true,
               {x, track.poses.at(frame)->data()});
   }
   obs.in_graph = true;
@@ -197,6 +215,7 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
     double* cur = newBlock(track.poses[f], o_f);
     double* change = newBlock(track.changes[f - 1], fromBlock(prev).inverse() * o_f);  // eq. 2
     addFactor(PoseChangeFactor::Create(sqrtInformation(config_.pose_change_sigma)), false, {prev, cur, change});
+    if (isVehicle(track.type)) addFactor(VehicleMotionFactor::Create(config_.vehicle_motion_sigma), false, {change});
     auto before = track.changes.find(f - 2);
     if (before != track.changes.end())
       addFactor(ConstantVelocityFactor::Create(sqrtInformation(config_.constant_velocity_sigma)), false,
@@ -416,6 +435,14 @@ void SlidingWindow::addFactor(ceres::CostFunction* cost, bool robust, std::vecto
 double* SlidingWindow::newBlock(Block& slot, const Pose& value) {
   slot = std::make_unique<Vector7>(toBlock(value));
   return slot->data();
+}
+
+double SlidingWindow::noiseGrowth(double range_m) const {
+  return 1.0 + config_.observation_sigma_growth_per_m * range_m;
+}
+
+bool SlidingWindow::isVehicle(const std::string& type) const {
+  return std::find(config_.vehicle_types.begin(), config_.vehicle_types.end(), type) != config_.vehicle_types.end();
 }
 
 const SlidingWindow::EgoFrame* SlidingWindow::findFrame(int frame) const {

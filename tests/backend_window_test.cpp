@@ -350,6 +350,29 @@ TEST(BackendSlidingWindow, MovingVehiclesCorrectAnOdometryPitchDrift) {
   EXPECT_LT(joint, 0.7 * no_prior);
 }
 
+TEST(BackendSlidingWindow, CoastingTrackKeepsItsVelocityWhileItsChainLeavesTheWindow) {
+  // A car seen for 20 frames, then not: until its last observation leaves the window it is
+  // output (coasting) with the velocity its chain gave, not a fit of the one or two sightings
+  // left in the window (or none at all: zero).
+  SimScene scene;
+  scene.ego = constantTwist(Pose::Identity(), 8.0, 0.0);
+  SimObject car;
+  car.id = 1;
+  car.pose = constantTwist(planarPose(10, -3.5, 0), 12.0, 0.0);
+  car.visible = [](int f) { return f < 20; };
+  scene.objects = {car};
+  scene.box_noise = Eigen::Vector3d(0.1, 0.1, 0.05);
+  SlidingWindow window(streetConfig());
+  int coasting = 0;
+  for (const BackendOutput& out : run(window, scene.generate(35)))
+    for (const TrackEstimate& e : out.tracks) {
+      if (e.status != TrackStatus::Coasting) continue;
+      ++coasting;
+      EXPECT_NEAR(e.velocity.head<2>().norm(), 12.0, 1.0) << "frame " << out.frame;
+    }
+  EXPECT_GE(coasting, 8);
+}
+
 TEST(BackendSlidingWindow, ParkedCarPullsOutTurnsDynamic) {
   SimScene scene;
   scene.ego = constantTwist(Pose::Identity(), 5.0, 0.0);

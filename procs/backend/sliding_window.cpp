@@ -313,7 +313,7 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
     return solver_.covariance(block).value_or(Matrix6::Zero());
   };
   out.ego_covariance = covariance(frames_.back().pose->data());
-  for (const auto& [id, track] : tracks_) {
+  for (auto& [id, track] : tracks_) {
     if (track.model == TrackModel::kNotInGraph) continue;
     TrackEstimate e;
     e.id = id;
@@ -333,29 +333,35 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
       const auto& [f_last, o_last] = *track.poses.rbegin();
       block = f_last == t ? o_last->data() : nullptr;
       e.pose = *predictedPose(track);
-      if (track.changes.size() < 2) {
-        // Not in O_cons yet (eq. 12: no constant-velocity factor smooths its pose change): the
-        // velocity of the trajectory's observed positions in the window says more.
-        if (const auto fit = windowMotion(track)) e.velocity = fit->velocity;
-      } else {
-        // Angular velocity from the latest pose change c_f^{f+1} = o_f^-1 o_{f+1} over its time; the
-        // linear velocity from the chain's displacement over the last velocity_frames frames.
+      if (track.changes.size() >= 2) {
+        // In O_cons (eq. 11 smooths its pose changes). Angular velocity from the latest pose change
+        // c_f^{f+1} = o_f^-1 o_{f+1} over its time; the linear velocity from the chain's
+        // displacement over the last velocity_frames frames.
         const auto& [f, c_block] = *track.changes.rbegin();
         const EgoFrame *a = findFrame(f), *b = findFrame(f + 1);
         const double dt = a && b ? 1e-6 * static_cast<double>(b->utime - a->utime) : 0.0;
         if (dt > 0) {
           const Eigen::Matrix3d R_f = fromBlock(track.poses.at(f)->data()).linear();
           const Vector6 c = logPose(fromBlock(c_block->data()));
-          e.angular_velocity = R_f * c.tail<3>() / dt;
+          track.angular_velocity = R_f * c.tail<3>() / dt;
         }
         const auto last = track.poses.rbegin();
         auto first = last;
         for (int i = 0; i < config_.velocity_frames && std::next(first) != track.poses.rend(); ++i) ++first;
         const EgoFrame *fa = findFrame(first->first), *fb = findFrame(last->first);
         const double span = fa && fb ? 1e-6 * static_cast<double>(fb->utime - fa->utime) : 0.0;
-        if (span > 0)
-          e.velocity = (fromBlock(last->second->data()).translation() - fromBlock(first->second->data()).translation()) / span;
+        if (span > 0) {
+          track.velocity = (fromBlock(last->second->data()).translation() - fromBlock(first->second->data()).translation()) / span;
+          track.velocity_from_chain = true;
+        }
+      } else if (!track.velocity_from_chain) {
+        // Young (no constant-velocity factor yet): the motion of its observed positions in the
+        // window, evidence before initialization included. A track whose chain the window has
+        // cut short (coasting, or leaving) keeps the velocity its chain last gave.
+        if (const auto fit = windowMotion(track)) track.velocity = fit->velocity;
       }
+      if (track.velocity) e.velocity = *track.velocity;
+      e.angular_velocity = track.angular_velocity;
     }
     if (block) e.covariance = covariance(block);
     out.tracks.push_back(std::move(e));
@@ -396,6 +402,8 @@ SmoothedPose SlidingWindow::slide() {
     track->landmark.reset();
     track->poses.clear();
     track->changes.clear();
+    track->velocity.reset();
+    track->velocity_from_chain = false;
   }
   // Tracks with nothing left in the window are forgotten (first_seen_ keeps their age).
   for (auto it = tracks_.begin(); it != tracks_.end();)

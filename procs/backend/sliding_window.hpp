@@ -70,6 +70,11 @@ class SlidingWindow {
     std::map<int, Block> poses;     // dynamic: frame -> o_frame
     std::map<int, Block> changes;   // dynamic: frame f -> c_f^{f+1}
     std::map<int, Observation> observations;  // frames in the window
+    // The motion last estimated (world frame): kept while the window holds too little of the
+    // chain to estimate it again (coasting, or about to leave).
+    std::optional<Eigen::Vector3d> velocity;
+    bool velocity_from_chain = false;
+    Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
   };
 
   void addEgoFrame(const BackendInput& in);

@@ -59,7 +59,7 @@ ClearMot evaluateClearMot(const std::vector<TrackingFrame>& frames, const MatchC
       last_match[g.box.id] = h.box.id;
       current[g.box.id] = h.box.id;
       if (g.velocity && h.velocity)
-        m.velocities.push_back({static_cast<int>(index), g.box.type, g.dynamic,
+        m.velocities.push_back({static_cast<int>(index), g.box.id, h.box.id, g.box.type, g.dynamic,
                                 static_cast<int>(index) - first_output.at(h.box.id), *g.velocity, *h.velocity});
       if (g.dynamic && g.velocity && h.velocity) {
         velocity_sq_sum += (*g.velocity - *h.velocity).squaredNorm();

@@ -297,11 +297,12 @@ std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plo
 
 void writeVelocityErrorsCsv(const std::string& path, const Metrics& m) {
   std::ostringstream out;
-  out << "frame_index,class,dynamic,track_age,truth_vx,truth_vy,track_vx,track_vy,error_mps\n";
+  out << "frame_index,label_id,track_id,class,dynamic,track_age,truth_vx,truth_vy,track_vx,track_vy,error_mps\n";
   if (m.tracking)
     for (const VelocityPair& p : m.tracking->clear.velocities) {
       char buf[256];
-      std::snprintf(buf, sizeof buf, "%d,%s,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f\n", p.frame_index, p.type.c_str(),
+      std::snprintf(buf, sizeof buf, "%d,%d,%d,%s,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f\n", p.frame_index, p.label_id,
+                    p.track_id, p.type.c_str(),
                     p.dynamic ? 1 : 0, p.track_age, p.truth.x(), p.truth.y(), p.track.x(), p.track.y(), p.error());
       out << buf;
     }

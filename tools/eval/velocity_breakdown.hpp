@@ -14,6 +14,7 @@ namespace dlslot::eval {
 // One matched label/track pair with a velocity on both sides (m/s, the scan's lidar axes).
 struct VelocityPair {
   int frame_index = 0;  // position of the scan in the evaluated sequence (0-based)
+  int label_id = -1, track_id = -1;
   std::string type;     // the label's class
   bool dynamic = false;  // the label moves (velocity.hpp: markDynamicLabels)
   int track_age = 0;     // scans since the track was first output (0 = its first scan)

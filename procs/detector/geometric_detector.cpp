@@ -1,0 +1,95 @@
+#include "detector/geometric_detector.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include "detector/ground_segmentation.hpp"
+#include "detector/object_class.hpp"
+#include "detector/range_image_clustering.hpp"
+#include "detector/rectangle_fit.hpp"
+#include "detector/scan_layout.hpp"
+
+namespace dlslot::detector {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point& t) {
+  const Clock::time_point now = Clock::now();
+  const double ms = std::chrono::duration<double, std::milli>(now - t).count();
+  t = now;
+  return ms;
+}
+
+// ClusterShape::fill of one cluster (scratch vectors passed in to keep their memory).
+double rangeImageFill(const ScanLayout& layout, const std::vector<int>& members, std::vector<int>& pixels,
+                      std::vector<int>& rows) {
+  pixels.clear();
+  rows.clear();
+  int c_min = layout.columns, c_max = -1;
+  const int c0 = layout.column[members[0]];
+  for (int i : members) {
+    // Columns relative to the first point's, unwrapped across the back of the image.
+    int c = layout.column[i] - c0;
+    if (c > layout.columns / 2) c -= layout.columns;
+    if (c < -layout.columns / 2) c += layout.columns;
+    c_min = std::min(c_min, c);
+    c_max = std::max(c_max, c);
+    pixels.push_back(layout.row[i] * 2 * layout.columns + (c + layout.columns));
+    rows.push_back(layout.row[i]);
+  }
+  std::sort(pixels.begin(), pixels.end());
+  std::sort(rows.begin(), rows.end());
+  const double occupied = static_cast<double>(std::unique(pixels.begin(), pixels.end()) - pixels.begin());
+  const double beams = static_cast<double>(std::unique(rows.begin(), rows.end()) - rows.begin());
+  return occupied / (beams * (c_max - c_min + 1));
+}
+
+}  // namespace
+
+DetectionResult detectObjects(const PointCloud& scan, const DetectorConfig& cfg) {
+  DetectionResult out;
+  auto t = Clock::now();
+  const ScanLayout layout = layoutScan(scan, cfg);
+  out.timings.emplace_back("layout", msSince(t));
+  const GroundModel ground = fitGround(scan, layout, cfg.window, cfg.ground);
+  const std::vector<uint8_t> obstacle = obstacleMask(scan, layout, ground, cfg.ground);
+  out.timings.emplace_back("ground", msSince(t));
+  const std::vector<std::vector<int>> clusters = clusterRangeImage(scan, layout, obstacle, cfg.clustering);
+  out.timings.emplace_back("clustering", msSince(t));
+  out.points_used = layout.num_used;
+  out.obstacle_points = static_cast<int>(std::count(obstacle.begin(), obstacle.end(), 1));
+  out.clusters = static_cast<int>(clusters.size());
+
+  std::vector<Eigen::Vector2f> xy;
+  std::vector<int> pixels, rows;
+  for (const std::vector<int>& members : clusters) {
+    ClusterShape shape;
+    shape.num_points = static_cast<int>(members.size());
+    shape.min_z = shape.max_z = scan(2, members[0]);
+    shape.max_tan = -1e9;
+    xy.clear();
+    for (int i : members) {
+      const float z = scan(2, i);
+      shape.min_z = std::min<double>(shape.min_z, z);
+      shape.max_z = std::max<double>(shape.max_z, z);
+      shape.max_tan = std::max<double>(shape.max_tan, z / layout.range[i]);
+      xy.emplace_back(scan(0, i), scan(1, i));
+    }
+    shape.fill = rangeImageFill(layout, members, pixels, rows);
+    shape.seen = fitRectangle(xy);
+    shape.ground_z = ground.heightAt(static_cast<float>(shape.seen.center.x()), static_cast<float>(shape.seen.center.y()));
+    // The ground under an object is the lowest of its cell and the object's own bottom (a
+    // cluster that starts below the fitted ground stands in a dip).
+    shape.ground_z = std::min(shape.ground_z, shape.min_z);
+    if (std::optional<Box> box = classifyCluster(shape, cfg.classes)) {
+      ++out.per_type[box->type];
+      out.boxes.push_back(std::move(*box));
+      out.shapes.push_back(shape);
+    }
+  }
+  out.timings.emplace_back("boxes", msSince(t));
+  return out;
+}
+
+}  // namespace dlslot::detector

@@ -13,6 +13,7 @@
 #include "detector/rectangle_fit.hpp"
 #include "detector/scan_layout.hpp"
 #include "dlslot/track_lifecycle.hpp"
+#include "trajectory_associator.hpp"
 
 using namespace dlslot;
 using namespace dlslot::detector;
@@ -205,4 +206,23 @@ TEST(DetectorUnknownType, TrackerClassesRefuseIt) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("never tracked"), std::string::npos) << e.what();
   }
+}
+
+TEST(DetectorUnknownType, TrackerNeverTracksUnknownBoxesHoweverConfident) {
+  // The same confident box at the same place for ten frames: a car becomes a track, an Unknown never.
+  tracker::TrajectoryAssociator a(tracker::AssociatorConfig{});
+  int car_tracks = 0, unknown_associations = 0, unknown_skipped = 0;
+  for (int f = 0; f < 10; ++f) {
+    Box car = box("Car", 12, 3), unknown = box(kUnknownType, 20, -5);
+    car.score = unknown.score = 9.0;
+    const tracker::FrameAssociations r = a.associate(f, 0.1 * f, Pose::Identity(), {car, unknown});
+    for (const tracker::Association& as : r.associations) {
+      if (as.detection_index == 1) ++unknown_associations;
+      if (as.detection_index == 0 && as.new_track) ++car_tracks;
+    }
+    unknown_skipped += r.skipped.untracked_type;
+  }
+  EXPECT_EQ(car_tracks, 1);
+  EXPECT_EQ(unknown_associations, 0);
+  EXPECT_EQ(unknown_skipped, 10);
 }

@@ -53,6 +53,8 @@ DetectorConfig DetectorConfig::read(ConfigSection s) {
     k.get("distance_m", c.clustering.distance_m);
     k.get("distance_per_m", c.clustering.distance_per_m);
     k.get("min_points", c.clustering.min_points);
+    k.get("join_margin_m", c.clustering.join_margin_m);
+    k.get("join_max_diagonal_m", c.clustering.join_max_diagonal_m);
     k.finish();
   }
   {

@@ -34,6 +34,10 @@ struct ClusteringConfig {
   double distance_m = 0.45;         // neighbours closer than max(distance_m, distance_per_m x range) join
   double distance_per_m = 0.02;
   int min_points = 8;               // smaller clusters are noise
+  // Clusters whose bird's-eye boxes overlap (grown by join_margin_m) are one object when the joined
+  // box's diagonal stays within join_max_diagonal_m (joinOverlappingClusters()).
+  double join_margin_m = 0.1;
+  double join_max_diagonal_m = 7.0;
 };
 
 // One class's size window (visible extent after the vehicle prior completed it).

@@ -55,7 +55,9 @@ DetectionResult detectObjects(const PointCloud& scan, const DetectorConfig& cfg)
   const GroundModel ground = fitGround(scan, layout, cfg.window, cfg.ground);
   const std::vector<uint8_t> obstacle = obstacleMask(scan, layout, ground, cfg.ground);
   out.timings.emplace_back("ground", msSince(t));
-  const std::vector<std::vector<int>> clusters = clusterRangeImage(scan, layout, obstacle, cfg.clustering);
+  const std::vector<std::vector<int>> clusters =
+      joinOverlappingClusters(scan, clusterRangeImage(scan, layout, obstacle, cfg.clustering),
+                              cfg.clustering.join_margin_m, cfg.clustering.join_max_diagonal_m, cfg.clustering.min_points);
   out.timings.emplace_back("clustering", msSince(t));
   out.points_used = layout.num_used;
   out.obstacle_points = static_cast<int>(std::count(obstacle.begin(), obstacle.end(), 1));

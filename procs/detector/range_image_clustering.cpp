@@ -70,9 +70,72 @@ std::vector<std::vector<int>> clusterRangeImage(const PointCloud& scan, const Sc
     const int p = pixel[static_cast<size_t>(layout.row[i]) * cols + layout.column[i]];
     if (label[p] >= 0 && dist2(i, p) < threshold2(p)) clusters[label[p]].push_back(i);
   }
+  // Small pieces are kept here: joinOverlappingClusters() may give them a home.
+  clusters.erase(std::remove_if(clusters.begin(), clusters.end(), [](const std::vector<int>& c) { return c.size() < 3; }),
+                 clusters.end());
+  return clusters;
+}
+
+std::vector<std::vector<int>> joinOverlappingClusters(const PointCloud& scan, std::vector<std::vector<int>> clusters,
+                                                      double margin_m, double max_diagonal_m, int min_points) {
+  struct Aabb {
+    float x0, y0, x1, y1;
+  };
+  const int n = static_cast<int>(clusters.size());
+  std::vector<Aabb> box(n);
+  for (int k = 0; k < n; ++k) {
+    Aabb b{1e9f, 1e9f, -1e9f, -1e9f};
+    for (int i : clusters[k]) {
+      b.x0 = std::min(b.x0, scan(0, i));
+      b.y0 = std::min(b.y0, scan(1, i));
+      b.x1 = std::max(b.x1, scan(0, i));
+      b.y1 = std::max(b.y1, scan(1, i));
+    }
+    box[k] = b;
+  }
+  const float m = static_cast<float>(margin_m), d2 = static_cast<float>(max_diagonal_m * max_diagonal_m);
+  // Object-sized clusters only, sorted by x so the overlap search stops early.
+  std::vector<int> order;
+  for (int k = 0; k < n; ++k) {
+    const float dx = box[k].x1 - box[k].x0, dy = box[k].y1 - box[k].y0;
+    if (dx * dx + dy * dy <= d2) order.push_back(k);
+  }
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return box[a].x0 < box[b].x0; });
+  std::vector<int> parent(n);
+  for (int k = 0; k < n; ++k) parent[k] = k;
+  auto root = [&](int k) {
+    while (parent[k] != k) k = parent[k] = parent[parent[k]];
+    return k;
+  };
+  for (size_t a = 0; a < order.size(); ++a) {
+    for (size_t b = a + 1; b < order.size(); ++b) {
+      const int i = order[a], j = order[b];
+      if (box[j].x0 > box[i].x1 + m) break;
+      if (box[j].y0 > box[i].y1 + m || box[i].y0 > box[j].y1 + m) continue;
+      const int ri = root(i), rj = root(j);
+      if (ri == rj) continue;
+      const Aabb u{std::min(box[ri].x0, box[rj].x0), std::min(box[ri].y0, box[rj].y0), std::max(box[ri].x1, box[rj].x1),
+                   std::max(box[ri].y1, box[rj].y1)};
+      const float dx = u.x1 - u.x0, dy = u.y1 - u.y0;
+      if (dx * dx + dy * dy > d2) continue;
+      parent[rj] = ri;
+      box[ri] = u;  // the root's box is the joined one
+    }
+  }
   std::vector<std::vector<int>> out;
-  for (auto& c : clusters)
-    if (static_cast<int>(c.size()) >= cfg.min_points) out.push_back(std::move(c));
+  std::vector<int> slot(n, -1);
+  for (int k = 0; k < n; ++k) {
+    const int r = root(k);
+    if (slot[r] < 0) {
+      slot[r] = static_cast<int>(out.size());
+      out.emplace_back();
+    }
+    std::vector<int>& dst = out[slot[r]];
+    dst.insert(dst.end(), clusters[k].begin(), clusters[k].end());
+  }
+  out.erase(std::remove_if(out.begin(), out.end(),
+                           [&](const std::vector<int>& c) { return static_cast<int>(c.size()) < min_points; }),
+            out.end());
   return out;
 }
 

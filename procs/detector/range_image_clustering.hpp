@@ -21,4 +21,12 @@ namespace dlslot::detector {
 std::vector<std::vector<int>> clusterRangeImage(const PointCloud& scan, const ScanLayout& layout,
                                                 const std::vector<uint8_t>& obstacle, const ClusteringConfig& cfg);
 
+// Joins clusters of one object the range image split: a car's roof seen from above the car is hit
+// by successive beams metres apart along the ray, so its far part is no pixel neighbour of the
+// rest. Two clusters whose bird's-eye bounding boxes overlap (grown by margin_m) become one when
+// the joined box stays object-sized (diagonal <= max_diagonal_m), so walls swallow nothing.
+// Clusters below min_points are dropped after joining.
+std::vector<std::vector<int>> joinOverlappingClusters(const PointCloud& scan, std::vector<std::vector<int>> clusters,
+                                                      double margin_m, double max_diagonal_m, int min_points);
+
 }  // namespace dlslot::detector

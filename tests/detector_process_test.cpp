@@ -63,7 +63,7 @@ TEST(DetectorProcess, ScansInDetectionsOutFaultsCounted) {
   ASSERT_TRUE(handleUntil(lcm, [&] { return listen.has_status; }, 10.0)) << detector.output();
 
   DetectorScene street;
-  const Box car = street.place("Car", 12.0, 4.0, -0.2, 4.2, 1.75, 1.5);
+  const Box car = street.car(12.0, 4.0, -0.2, 4.2, 1.75, 1.5);
   const Box person = street.place("Pedestrian", 8.0, -3.0, 0.0, 0.7, 0.55, 1.75);
   const PointCloud cloud = street.scan();
 

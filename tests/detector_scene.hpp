@@ -32,6 +32,15 @@ struct DetectorScene {
     boxes.push_back(b);
     return boxes.back();
   }
+  // A car standing at (x, y): a body to 60 % of its height and a cabin on it (half the length,
+  // 85 % of the width), as a lidar sees one (a level box is a wall's shape). Returns its box.
+  Box car(double x, double y, double yaw, double l, double w, double h) {
+    const Box outer = place("Car", x, y, yaw, l, w, h);
+    boxes.back().size.z() = 0.6 * h;
+    boxes.back().center.z() = groundZ(x, y) + 0.3 * h;
+    place("Car", x, y, yaw, 0.5 * l, 0.85 * w, h);
+    return outer;
+  }
   void pole(double x, double y, double radius, double height) { poles.push_back({{x, y}, radius, height}); }
 
   // The scan: 64 beams at the HDL-64E's elevations (+2 .. -24.9 deg), `azimuth_steps` a turn.

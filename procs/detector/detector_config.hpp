@@ -36,16 +36,17 @@ struct ClusteringConfig {
   int min_points = 8;               // smaller clusters are noise
   // Clusters whose bird's-eye boxes overlap (grown by join_margin_m) are one object when the joined
   // box's diagonal stays within join_max_diagonal_m (joinOverlappingClusters()).
-  double join_margin_m = 0.1;
+  double join_margin_m = 0.4;
   double join_max_diagonal_m = 7.0;
 };
 
 // One class's size window (visible extent after the vehicle prior completed it).
 struct SizeWindow {
   double min_length_m = 0, max_length_m = 0, min_width_m = 0, max_width_m = 0, min_height_m = 0, max_height_m = 0;
-  bool contains(double l, double w, double h) const {
-    return l >= min_length_m && l <= max_length_m && w >= min_width_m && w <= max_width_m && h >= min_height_m &&
-           h <= max_height_m;
+  // height_is_lower_bound: the object was cut off by the top beam, so it may be taller than h.
+  bool contains(double l, double w, double h, bool height_is_lower_bound = false) const {
+    return l >= min_length_m && l <= max_length_m && w >= min_width_m && w <= max_width_m &&
+           (h >= min_height_m || height_is_lower_bound) && h <= max_height_m;
   }
 };
 
@@ -57,14 +58,18 @@ struct ClassConfig {
   double car_side_min_m = 2.3;
   // A short, wide cluster (neither a side nor a back) is a car's corner only with this share of its
   // points on the rectangle's edges (foliage has fewer).
-  double min_corner_edge_fraction = 0.45;
-  SizeWindow car{3.2, 5.4, 1.4, 2.2, 1.1, 1.9};
+  double min_corner_edge_fraction = 0.4;
+  // A seen side at least car_side_min_m long whose quarters' tops differ by less than this is a
+  // wall or a barrier (ClusterShape::profile_step).
+  double min_profile_step_m = 0.2;
+  SizeWindow car{3.2, 5.4, 1.4, 2.2, 1.0, 1.9};
   SizeWindow van{4.2, 6.5, 1.7, 2.4, 1.9, 2.8};
   SizeWindow truck{6.0, 14.0, 2.0, 3.0, 2.5, 4.2};
   SizeWindow pedestrian{0.2, 1.1, 0.15, 0.9, 1.2, 2.05};
   SizeWindow cyclist{1.2, 2.2, 0.25, 1.0, 1.1, 2.05};
   double pole_max_width_m = 0.3;     // thinner and cut off by the top beam, or taller than a person: a pole
-  double max_bottom_m = 0.6;         // a cluster starting higher above the ground is an overhang
+  double max_bottom_m = 1.2;         // a cluster starting higher above the ground is an overhang (a car seen
+                                     // over a median barrier starts ~1 m up)
   // Unknown: object-like (footprint within this, height within this) but no class fits: its points
   // are still removed for the odometry; anything larger or flatter is background (not published).
   double unknown_max_length_m = 6.0, unknown_max_height_m = 3.0, unknown_min_height_m = 0.5;

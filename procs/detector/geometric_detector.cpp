@@ -45,6 +45,24 @@ double rangeImageFill(const ScanLayout& layout, const std::vector<int>& members,
   return occupied / (beams * (c_max - c_min + 1));
 }
 
+// ClusterShape::profile_step: the highest point of each quarter of the rectangle's length.
+double profileStep(const PointCloud& scan, const std::vector<int>& members, const Rectangle& r) {
+  if (r.length < 1e-3) return 0.0;
+  const Eigen::Vector2f u(static_cast<float>(std::cos(r.yaw)), static_cast<float>(std::sin(r.yaw)));
+  const Eigen::Vector2f c = r.center.cast<float>();
+  const float inv = static_cast<float>(1.0 / r.length);
+  float top[4] = {-1e9f, -1e9f, -1e9f, -1e9f};
+  for (int i : members) {
+    const float t = (Eigen::Vector2f(scan(0, i), scan(1, i)) - c).dot(u) * inv + 0.5f;
+    const int q = std::min(3, std::max(0, static_cast<int>(t * 4)));
+    top[q] = std::max(top[q], scan(2, i));
+  }
+  float hi = -1e9f, lo = 1e9f;
+  for (float z : top)
+    if (z > -1e8f) hi = std::max(hi, z), lo = std::min(lo, z);
+  return hi > lo ? hi - lo : 0.0;
+}
+
 }  // namespace
 
 DetectionResult detectObjects(const PointCloud& scan, const DetectorConfig& cfg) {
@@ -80,6 +98,7 @@ DetectionResult detectObjects(const PointCloud& scan, const DetectorConfig& cfg)
     }
     shape.fill = rangeImageFill(layout, members, pixels, rows);
     shape.seen = fitRectangle(xy);
+    shape.profile_step = profileStep(scan, members, shape.seen);
     shape.ground_z = ground.heightAt(static_cast<float>(shape.seen.center.x()), static_cast<float>(shape.seen.center.y()));
     // The ground under an object is the lowest of its cell and the object's own bottom (a
     // cluster that starts below the fitted ground stands in a dip).

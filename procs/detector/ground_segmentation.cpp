@@ -6,6 +6,10 @@
 
 namespace dlslot::detector {
 
+namespace {
+constexpr float kNearRange_m = 4.0f;  // HDL-64E at 1.73 m: the first ground ring is 3.7 m out
+}  // namespace
+
 float GroundModel::heightAt(float x, float y) const {
   const float rho = std::sqrt(x * x + y * y);
   const float az = std::atan2(y, x) + static_cast<float>(M_PI);
@@ -33,15 +37,20 @@ GroundModel fitGround(const PointCloud& scan, const ScanLayout& layout, const Sc
   g.fitted.assign(cells, 0);
   const float step = static_cast<float>(cfg.max_step_m), slope_max = static_cast<float>(cfg.max_slope);
   for (int s = 0; s < g.sectors; ++s) {
-    // The ground line starts under the sensor, level.
+    // The ground line starts under the sensor, level: the vehicle stands on the ground it sees
+    // first, so up to kNearRange_m no slope is allowed (the lowest points of a vehicle beside the
+    // ego, whose own ground the lidar cannot see, must not become the ground).
     float last_r = 0.0f, last_z = static_cast<float>(-window.sensor_height_m), slope = 0.0f;
+    bool fitted_any = false;
     for (int b = 0; b < g.bins; ++b) {
       const int c = s * g.bins + b;
       const float r = (b + 0.5f) * static_cast<float>(g.bin_m);
       const float run = r - last_r;
       const float expected = last_z + slope * run;
       const float z = lowest[c];
-      if (z != kEmpty && std::abs(z - expected) <= step + slope_max * run) {
+      const float allowed = step + slope_max * (fitted_any ? run : std::max(0.0f, r - kNearRange_m));
+      if (z != kEmpty && std::abs(z - expected) <= allowed) {
+        fitted_any = true;
         // Continues the ground. The sector's slope follows the fitted cells (smoothed: one noisy
         // bin must not tilt the line), within the slope a road can have.
         if (run > 0.5f * static_cast<float>(g.bin_m)) {

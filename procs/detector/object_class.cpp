@@ -43,8 +43,9 @@ Rectangle completeVehicle(const Rectangle& seen, double prior_length_m, double p
   Rectangle r = seen;
   double seen_l = seen.length, seen_w = seen.width, yaw = seen.yaw;
   const Eigen::Vector2d radial = seen.center.norm() > 1e-6 ? Eigen::Vector2d(seen.center.normalized()) : Eigen::Vector2d(1, 0);
-  // A short face across the line of sight, thin in depth: the back or the front.
-  if (seen_l < side_min_m && std::abs(axisOf(yaw).dot(radial)) < 0.7 && seen_w < 0.8) {
+  // A face no wider than a car's back, across the line of sight: the back or the front (with the
+  // roof seen behind it, it may be a metre or more deep).
+  if (seen_l < side_min_m && seen_l <= prior_width_m + 0.4 && std::abs(axisOf(yaw).dot(radial)) < 0.7) {
     std::swap(seen_l, seen_w);
     yaw += M_PI / 2;
   }
@@ -68,18 +69,25 @@ std::optional<Box> classifyCluster(const ClusterShape& s_in, const ClassConfig& 
   const Rectangle& seen = s.seen;
   if (bottom > cfg.max_bottom_m) return std::nullopt;  // hangs above the ground: canopy, sign, overhang
   const bool cut_at_top = s.max_tan >= cfg.top_tan - kTopMargin;
-  // Cut off by the top beam (e.g. up a slope), the seen height is only a lower bound: at least a
-  // car's then, so the footprint decides.
+  // Cut off by the top beam (beside the ego, up a slope), the seen height is only a lower bound: the
+  // windows' minimum heights do not apply, and the box is at least a car's height.
   if (cut_at_top) s.max_z = std::max(s.max_z, s.ground_z + cfg.car.min_height_m);
   const double h = s.max_z - s.ground_z;
   // Poles and trunks: thin, and taller than a person or reaching the top beam.
   if (seen.length <= cfg.pole_max_width_m && (cut_at_top || h > cfg.pedestrian.max_height_m)) return std::nullopt;
   const double seen_area = seen.length * seen.width;
 
+  // A vehicle's side is not level (bonnet, roof, boot; a truck's cab below its box): a thin, level
+  // stretch as long as a side is a wall or a barrier, unless the top beam cut it off. (An L-shape
+  // is a corner, level or not: a partly seen car shows only its roof's rear part.)
+  const bool level_side = seen.length >= cfg.car_side_min_m && seen.width < 1.0 && !cut_at_top &&
+                          s.profile_step < cfg.min_profile_step_m;
+  if (level_side) return std::nullopt;
+
   // Vehicles seen whole (a van or a truck is its own prior).
-  if (cfg.truck.contains(seen.length, seen.width, h))
+  if (cfg.truck.contains(seen.length, seen.width, h, cut_at_top))
     return makeBox(seen, s, "Truck", logit(confidence(s.num_points, 60, seen.edge_fraction, 1.0)));
-  if (cfg.van.contains(seen.length, seen.width, h))
+  if (cfg.van.contains(seen.length, seen.width, h, cut_at_top))
     return makeBox(seen, s, "Van", logit(confidence(s.num_points, 50, seen.edge_fraction, 1.0)));
 
   // People: small footprint, person height, not cut off by the top beam (so not a pole or a wall).
@@ -103,8 +111,8 @@ std::optional<Box> classifyCluster(const ClusterShape& s_in, const ClassConfig& 
     const double share = seen_area / std::max(1e-6, full.length * full.width) +
                          0.5 * std::max(seen.length, seen.width) / full.length;
     const double score = logit(confidence(s.num_points, 40, std::max(0.3, seen.edge_fraction), share));
-    if (cfg.car.contains(full.length, full.width, h)) return makeBox(full, s, "Car", score);
-    if (cfg.van.contains(full.length, full.width, h)) return makeBox(full, s, "Van", score);
+    if (cfg.car.contains(full.length, full.width, h, cut_at_top)) return makeBox(full, s, "Car", score);
+    if (cfg.van.contains(full.length, full.width, h, cut_at_top)) return makeBox(full, s, "Van", score);
   }
 
   // Object-sized but no class: removed for the odometry, never tracked.

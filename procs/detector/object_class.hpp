@@ -25,12 +25,15 @@ struct ClusterShape {
   // Solidity in the range image: occupied pixels / (azimuth columns spanned x beam rows present).
   // A car's or a wall's surface fills its span; foliage, fences and noise leave holes.
   double fill = 1.0;
+  // Height profile along the seen length: highest point of each quarter, highest minus lowest
+  // quarter. A vehicle's bonnet and boot sit below its roof; walls and barriers are level.
+  double profile_step = 0.0;
 };
 
 // A vehicle's rectangle completed to at least the prior size when only part of it was seen. The
 // seen face nearest the sensor stays where it is and the box grows away from the sensor (at the
-// origin). A short face seen across the line of sight is the vehicle's back or front, so its
-// length axis is turned to run across that face.
+// origin). A face no wider than a car's back seen across the line of sight is the vehicle's back
+// or front, so its length axis is turned to run across that face.
 Rectangle completeVehicle(const Rectangle& seen, double prior_length_m, double prior_width_m, double side_min_m);
 
 // The detection for a cluster: a box (centre at half its height above the ground) with a KITTI

@@ -27,10 +27,10 @@ struct GroundConfig {
 
 // Range-image neighbourhood clustering (range_image_clustering.hpp).
 struct ClusteringConfig {
-  int columns = 2048;               // azimuth columns of the range image
+  int columns = 1024;               // azimuth columns of the range image
   double row_step = 0.004;          // vertical pixel size in tan(elevation) (HDL-64E beams are 0.0058-0.009 apart)
   int neighbour_rows = 3;           // a point's neighbours: this many rows up and down...
-  int neighbour_columns = 2;        // ...and columns left and right
+  int neighbour_columns = 1;        // ...and columns left and right
   double distance_m = 0.45;         // neighbours closer than max(distance_m, distance_per_m x range) join
   double distance_per_m = 0.02;
   int min_points = 8;               // smaller clusters are noise

@@ -21,30 +21,6 @@ double msSince(Clock::time_point& t) {
   return ms;
 }
 
-// ClusterShape::fill of one cluster (scratch vectors passed in to keep their memory).
-double rangeImageFill(const ScanLayout& layout, const std::vector<int>& members, std::vector<int>& pixels,
-                      std::vector<int>& rows) {
-  pixels.clear();
-  rows.clear();
-  int c_min = layout.columns, c_max = -1;
-  const int c0 = layout.column[members[0]];
-  for (int i : members) {
-    // Columns relative to the first point's, unwrapped across the back of the image.
-    int c = layout.column[i] - c0;
-    if (c > layout.columns / 2) c -= layout.columns;
-    if (c < -layout.columns / 2) c += layout.columns;
-    c_min = std::min(c_min, c);
-    c_max = std::max(c_max, c);
-    pixels.push_back(layout.row[i] * 2 * layout.columns + (c + layout.columns));
-    rows.push_back(layout.row[i]);
-  }
-  std::sort(pixels.begin(), pixels.end());
-  std::sort(rows.begin(), rows.end());
-  const double occupied = static_cast<double>(std::unique(pixels.begin(), pixels.end()) - pixels.begin());
-  const double beams = static_cast<double>(std::unique(rows.begin(), rows.end()) - rows.begin());
-  return occupied / (beams * (c_max - c_min + 1));
-}
-
 // ClusterShape::profile_step: the highest point of each quarter of the rectangle's length.
 double profileStep(const PointCloud& scan, const std::vector<int>& members, const Rectangle& r) {
   if (r.length < 1e-3) return 0.0;
@@ -82,7 +58,6 @@ DetectionResult detectObjects(const PointCloud& scan, const DetectorConfig& cfg)
   out.clusters = static_cast<int>(clusters.size());
 
   std::vector<Eigen::Vector2f> xy;
-  std::vector<int> pixels, rows;
   for (const std::vector<int>& members : clusters) {
     ClusterShape shape;
     shape.num_points = static_cast<int>(members.size());
@@ -96,7 +71,6 @@ DetectionResult detectObjects(const PointCloud& scan, const DetectorConfig& cfg)
       shape.max_tan = std::max<double>(shape.max_tan, z / layout.range[i]);
       xy.emplace_back(scan(0, i), scan(1, i));
     }
-    shape.fill = rangeImageFill(layout, members, pixels, rows);
     shape.seen = fitRectangle(xy);
     shape.profile_step = profileStep(scan, members, shape.seen);
     shape.ground_z = ground.heightAt(static_cast<float>(shape.seen.center.x()), static_cast<float>(shape.seen.center.y()));

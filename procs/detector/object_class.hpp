@@ -22,9 +22,6 @@ struct ClusterShape {
   double min_z = 0, max_z = 0;
   double max_tan = 0;       // highest elevation (z / horizontal range) of its points
   int num_points = 0;
-  // Solidity in the range image: occupied pixels / (azimuth columns spanned x beam rows present).
-  // A car's or a wall's surface fills its span; foliage, fences and noise leave holes.
-  double fill = 1.0;
   // Height profile along the seen length: highest point of each quarter, highest minus lowest
   // quarter. A vehicle's bonnet and boot sit below its roof; walls and barriers are level.
   double profile_step = 0.0;

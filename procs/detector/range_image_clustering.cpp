@@ -11,8 +11,12 @@ std::vector<std::vector<int>> clusterRangeImage(const PointCloud& scan, const Sc
   // The image: the nearest obstacle point of each pixel.
   std::vector<int> pixel(static_cast<size_t>(rows) * cols, -1);
   std::vector<int> spare;  // obstacle points behind a nearer one in their pixel
+  // Rows holding any point: the rows are finer than the beams, so most rows are empty and the
+  // neighbourhood search skips them (a third of the lookups).
+  std::vector<uint8_t> row_used(rows, 0);
   for (int i = 0; i < n; ++i) {
     if (!obstacle[i]) continue;
+    row_used[layout.row[i]] = 1;
     int& p = pixel[static_cast<size_t>(layout.row[i]) * cols + layout.column[i]];
     if (p < 0) {
       p = i;
@@ -51,6 +55,7 @@ std::vector<std::vector<int>> clusterRangeImage(const PointCloud& scan, const Sc
       const float t2 = threshold2(p);
       const int r0 = std::max(0, layout.row[p] - R), r1 = std::min(rows - 1, layout.row[p] + R);
       for (int r = r0; r <= r1; ++r) {
+        if (!row_used[r]) continue;
         const int* line = &pixel[static_cast<size_t>(r) * cols];
         for (int dc = -C; dc <= C; ++dc) {
           int c = layout.column[p] + dc;

@@ -129,10 +129,10 @@ TEST(DetectorParts, PolesAndOverhangsAreBackgroundUnknownsAreMarked) {
   canopy.seen.length = canopy.seen.width = 2.0;
   canopy.min_z = -0.2;  // 1.5 m above the ground
   EXPECT_FALSE(classifyCluster(canopy, cfg).has_value());
-  ClusterShape bin = pole;  // a 1 m x 0.9 m box 1.1 m tall: no class, but object-sized
-  bin.seen.length = 1.0;
-  bin.seen.width = 0.9;
-  bin.max_z = -0.63;
+  ClusterShape bin = pole;  // a 1.5 m x 1.4 m box 1.3 m tall: no class, but object-sized
+  bin.seen.length = 1.5;
+  bin.seen.width = 1.4;
+  bin.max_z = -0.43;
   bin.max_tan = -0.08;
   const std::optional<Box> b = classifyCluster(bin, cfg);
   ASSERT_TRUE(b.has_value());

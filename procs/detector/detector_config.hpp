@@ -27,10 +27,10 @@ struct GroundConfig {
 
 // Range-image neighbourhood clustering (range_image_clustering.hpp).
 struct ClusteringConfig {
-  int columns = 1024;               // azimuth columns of the range image
+  int columns = 2048;               // azimuth columns of the range image
   double row_step = 0.004;          // vertical pixel size in tan(elevation) (HDL-64E beams are 0.0058-0.009 apart)
   int neighbour_rows = 3;           // a point's neighbours: this many rows up and down...
-  int neighbour_columns = 1;        // ...and columns left and right
+  int neighbour_columns = 2;        // ...and columns left and right
   double distance_m = 0.45;         // neighbours closer than max(distance_m, distance_per_m x range) join
   double distance_per_m = 0.02;
   int min_points = 8;               // smaller clusters are noise
@@ -72,7 +72,7 @@ struct ClassConfig {
                                      // over a median barrier starts ~1 m up)
   // Unknown: object-like (footprint within this, height within this) but no class fits: its points
   // are still removed for the odometry; anything larger or flatter is background (not published).
-  double unknown_max_length_m = 6.0, unknown_max_height_m = 3.0, unknown_min_height_m = 0.5;
+  double unknown_max_length_m = 2.0, unknown_max_height_m = 2.2, unknown_min_height_m = 1.2;
   double top_tan = 0.035;            // tan of the top beam's elevation (HDL-64E: +2 deg; config: top_beam_deg)
 };
 

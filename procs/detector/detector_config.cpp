@@ -67,7 +67,11 @@ DetectorConfig DetectorConfig::read(ConfigSection s) {
     cl.car_prior_width_m = prior[1];
     k.get("car_side_min_m", cl.car_side_min_m);
     k.get("min_corner_edge_fraction", cl.min_corner_edge_fraction);
+    k.get("min_side_edge_fraction", cl.min_side_edge_fraction);
+    k.get("min_vehicle_face_m", cl.min_vehicle_face_m);
     k.get("min_profile_step_m", cl.min_profile_step_m);
+    k.get("level_max_width_m", cl.level_max_width_m);
+    k.get("max_vehicle_profile_step_m", cl.max_vehicle_profile_step_m);
     cl.car = readWindow(k.section("car"));
     cl.van = readWindow(k.section("van"));
     cl.truck = readWindow(k.section("truck"));

@@ -59,9 +59,16 @@ struct ClassConfig {
   // A short, wide cluster (neither a side nor a back) is a car's corner only with this share of its
   // points on the rectangle's edges (foliage has fewer).
   double min_corner_edge_fraction = 0.4;
+  // ... and a wide one as long as a side this share (foliage has almost none on its edges).
+  double min_side_edge_fraction = 0.2;
+  // The shortest seen face completed to a car (a car's back is 1.5-1.9 m wide).
+  double min_vehicle_face_m = 1.4;
   // A seen side at least car_side_min_m long whose quarters' tops differ by less than this is a
   // wall or a barrier (ClusterShape::profile_step).
   double min_profile_step_m = 0.2;
+  double level_max_width_m = 1.5;  // ... when seen no wider than this (a wider L-shape is a corner)
+  // A cluster whose quarters' tops differ by more than this is foliage, not a vehicle.
+  double max_vehicle_profile_step_m = 1.3;
   SizeWindow car{3.2, 5.4, 1.4, 2.2, 1.0, 1.9};
   SizeWindow van{4.2, 6.5, 1.7, 2.4, 1.9, 2.8};
   SizeWindow truck{6.0, 14.0, 2.0, 3.0, 2.5, 4.2};

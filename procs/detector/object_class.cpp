@@ -10,6 +10,8 @@ namespace {
 // How far (in tan of elevation) below the top beam a cluster's highest point may be and still
 // count as cut off by it (the HDL-64E's top beams are 0.0058 apart).
 constexpr double kTopMargin = 0.006;
+// Within this range a van (2-2.5 m) reaches above the HDL-64E's top beam (1.73 m + 0.035 x range).
+constexpr double kBesideRange_m = 10.0;
 
 Eigen::Vector2d axisOf(double yaw) { return {std::cos(yaw), std::sin(yaw)}; }
 
@@ -78,16 +80,20 @@ std::optional<Box> classifyCluster(const ClusterShape& s_in, const ClassConfig& 
   const double seen_area = seen.length * seen.width;
 
   // A vehicle's side is not level (bonnet, roof, boot; a truck's cab below its box): a thin, level
-  // stretch as long as a side is a wall or a barrier, unless the top beam cut it off. (An L-shape
-  // is a corner, level or not: a partly seen car shows only its roof's rear part.)
-  const bool level_side = seen.length >= cfg.car_side_min_m && seen.width < 1.0 && !cut_at_top &&
+  // stretch as long as a side is a wall or a barrier, unless the top beam cut it off right beside
+  // the ego (a van there shows a level band). (A wide L-shape is a corner, level or not: a partly
+  // seen car shows only its roof's rear part.)
+  const bool cut_beside = cut_at_top && seen.center.norm() < kBesideRange_m;
+  const bool level_side = seen.length >= cfg.car_side_min_m && seen.width < cfg.level_max_width_m && !cut_beside &&
                           s.profile_step < cfg.min_profile_step_m;
   if (level_side) return std::nullopt;
+  // Tops that differ by more than a van's bonnet and roof: a tree or a bush, not a vehicle.
+  const bool ragged_top = s.profile_step > cfg.max_vehicle_profile_step_m;
 
   // Vehicles seen whole (a van or a truck is its own prior).
-  if (cfg.truck.contains(seen.length, seen.width, h, cut_at_top))
+  if (!ragged_top && cfg.truck.contains(seen.length, seen.width, h, cut_at_top))
     return makeBox(seen, s, "Truck", logit(confidence(s.num_points, 60, seen.edge_fraction, 1.0)));
-  if (cfg.van.contains(seen.length, seen.width, h, cut_at_top))
+  if (!ragged_top && cfg.van.contains(seen.length, seen.width, h, cut_at_top))
     return makeBox(seen, s, "Van", logit(confidence(s.num_points, 50, seen.edge_fraction, 1.0)));
 
   // People: small footprint, person height, not cut off by the top beam (so not a pole or a wall).
@@ -101,12 +107,15 @@ std::optional<Box> classifyCluster(const ClusterShape& s_in, const ClassConfig& 
 
   // Cars, also when partly seen: completed to the prior, then checked against the car window.
   const bool vehicle_height = h >= cfg.car.min_height_m && h <= cfg.van.max_height_m;
-  if (vehicle_height && seen.length >= 1.0 && seen.length <= cfg.van.max_length_m && seen.width <= cfg.van.max_width_m) {
+  if (vehicle_height && !ragged_top && seen.length >= cfg.min_vehicle_face_m && seen.length <= cfg.van.max_length_m && seen.width <= cfg.van.max_width_m) {
     // Neither a side nor a back seen but a blob of both: a corner (an L) only when the points lie on
     // its edges; foliage fills it.
     const bool blob = seen.length < cfg.car_side_min_m && seen.width > 0.8;
     if (blob && seen.edge_fraction < cfg.min_corner_edge_fraction)
       return makeBox(seen, s, kUnknownType, logit(0.2));
+    // A wide cluster as long as a side still needs some of its points on the edges (foliage has
+    // almost none there).
+    if (seen.width > 0.8 && seen.edge_fraction < cfg.min_side_edge_fraction) return std::nullopt;
     const Rectangle full = completeVehicle(seen, cfg.car_prior_length_m, cfg.car_prior_width_m, cfg.car_side_min_m);
     const double share = seen_area / std::max(1e-6, full.length * full.width) +
                          0.5 * std::max(seen.length, seen.width) / full.length;

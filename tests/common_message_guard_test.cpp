@@ -93,7 +93,7 @@ TEST(MessageGuard, LayoutWalkConsumesExactlyWhatLcmGenEncodes) {
 
 TEST(MessageGuard, CountsAndStringLengthsAreCheckedBeforeLcmGenAllocates) {
   expectStructuralRefusals(sampleScan(4), kScanStringAt, 4);
-  expectStructuralRefusals(sampleDetections(4), 0, 0);
+  expectStructuralRefusals(sampleDetections(4), kDetectionsSourceAt, 9, kDetectionsCountAt, 0);
   expectStructuralRefusals(sampleDetectionsWithBox(4), kDetectionsStringAt, 3, kDetectionsCountAt, 1);
   expectStructuralRefusals(sampleGroundTruth(4), kGroundTruthStringAt, 3);
   expectStructuralRefusals(sampleOdometry(4), kOdometryStringAt, 2);

@@ -85,16 +85,19 @@ inline detections_t sampleDetections(int frame) {
   detections_t m{};
   m.utime = 1000 + frame;
   m.frame = frame;
-  return m;  // num_boxes = 0; no string
+  m.source = "geometric";
+  return m;  // num_boxes = 0
 }
-// With one box: its count at 20, the box's type string at 24.
+// The source string at 20 (9 characters), the count at 34.
+constexpr size_t kDetectionsSourceAt = 20;
+// With one box: its count at 34, the box's type string at 38.
 inline detections_t sampleDetectionsWithBox(int frame) {
   detections_t m = sampleDetections(frame);
   m.boxes = {sampleBox(-1)};
   m.num_boxes = 1;
   return m;
 }
-constexpr size_t kDetectionsCountAt = 20, kDetectionsStringAt = 24;
+constexpr size_t kDetectionsCountAt = 34, kDetectionsStringAt = 38;
 
 inline ground_truth_t sampleGroundTruth(int frame) {
   ground_truth_t m{};

@@ -228,7 +228,7 @@ Refusal checkLayout(const point_cloud_t*, const void* data, size_t size) {
 
 Refusal checkLayout(const detections_t*, const void* data, size_t size) {
   Cursor c(data, size);
-  (void)(header(c, detections_t::getHash()) && boxes(c, "num_boxes"));
+  (void)(header(c, detections_t::getHash()) && c.str("source") && boxes(c, "num_boxes"));
   return c.finish();
 }
 

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "dlslot/types.hpp"
+
 namespace dlslot {
 namespace {
 
@@ -36,6 +38,9 @@ double detectionConfidence(double score, ScoreScale scale) {
 void ClassPolicy::validate() const {
   auto fail = [&](const std::string& what) { throw std::invalid_argument(name + "." + what); };
   if (types.empty()) fail("types: expected at least one KITTI type");
+  // Boxes no detector class fits are only for the odometry's point removal: never objects.
+  if (std::find(types.begin(), types.end(), kUnknownType) != types.end())
+    fail(std::string("types: '") + kUnknownType + "' is the type of unclassified detections and is never tracked");
   if (std::isnan(min_score)) fail("min_score: expected a number");
   if (!(min_score_to_extend <= min_score))
     fail("min_score_to_extend: expected <= min_score, got " + std::to_string(min_score_to_extend));

@@ -1,6 +1,7 @@
 // dlslot-player: plays a KITTI (tracking or odometry layout) sequence over LCM.
-// Publishes LIDAR_SCAN, DETECTIONS (every frame, empty when none) and GROUND_TRUTH (when the
-// data set has labels or poses), at a rate or in lockstep with a downstream channel.
+// Publishes LIDAR_SCAN, DETECTIONS (every frame, empty when none; source "files"; none with
+// --no-detections, when dlslot-detector makes them) and GROUND_TRUTH (when the data set has labels
+// or poses), at a rate or in lockstep with a downstream channel.
 #include <cstdio>
 #include <iostream>
 
@@ -36,7 +37,7 @@ int run(int argc, char** argv) {
   std::vector<std::string> detections;
   double speed = 1.0, delay_s = 0.5;
   int start = 0, end = -1;
-  bool quiet = false;
+  bool quiet = false, no_detections = false;
   CommandLine cl("dlslot-player", "Plays a KITTI sequence over LCM (LIDAR_SCAN, DETECTIONS, GROUND_TRUTH).");
   cl.option("--kitti", &root, "KITTI root (holding training/ or sequences/)");
   cl.option("--sequence", &sequence, "sequence name, e.g. 0000 or 07");
@@ -47,6 +48,8 @@ int run(int argc, char** argv) {
   cl.option("--end", &end, "last frame, inclusive (default: last)");
   cl.option("--delay", &delay_s, "seconds to wait before the first frame, for subscribers to start (default 0.5)");
   cl.flag("--quiet", &quiet, "no progress line");
+  cl.flag("--no-detections", &no_detections,
+          "publish no DETECTIONS (another process detects, e.g. dlslot-detector); not with --detections");
   node_opts.addTo(cl);
   if (!cl.parse(argc, argv)) return 0;
 
@@ -57,6 +60,8 @@ int run(int argc, char** argv) {
   if (node_opts.check_config) return 0;
   if (root.empty()) throw std::invalid_argument("--kitti ROOT is required");
   if (sequence.empty()) throw std::invalid_argument("--sequence SSSS is required");
+  if (no_detections && !detections.empty())
+    throw std::invalid_argument("--no-detections and --detections exclude each other");
 
   kitti::SequenceReader reader(root, sequence, detections, cfg.min_detection_score, cfg.frame_period_s);
   if (!reader.hasScans())
@@ -108,12 +113,15 @@ int run(int argc, char** argv) {
     toMsg(frame.scan, scan);
     node.publish(channels.scan, scan);
 
-    detections_t det;
-    det.utime = frame.utime;
-    det.frame = frame.index;
-    det.boxes = toMsg(frame.detections);
-    det.num_boxes = static_cast<int32_t>(det.boxes.size());
-    node.publish(channels.detections, det);
+    if (!no_detections) {
+      detections_t det;
+      det.utime = frame.utime;
+      det.frame = frame.index;
+      det.boxes = toMsg(frame.detections);
+      det.num_boxes = static_cast<int32_t>(det.boxes.size());
+      det.source = "files";
+      node.publish(channels.detections, det);
+    }
 
     if (frame.gt_pose || reader.hasLabels()) {
       ground_truth_t gt;

@@ -87,7 +87,7 @@ std::string spread(const std::vector<YAML::Node>& per_seed, const std::string& k
 }
 
 int compare(int argc, char** argv) {
-  std::string root, sequence = "0000", scenario, config = "config/dlslot.yaml", out, lcm_url;
+  std::string root, sequence = "0000", scenario, config = "config/dlslot.yaml", out, lcm_url, detector;
   std::vector<std::string> detections;
   std::string seeds_arg;
   int frames = -1, seed = 1;
@@ -95,6 +95,9 @@ int compare(int argc, char** argv) {
   cl.option("--kitti", &root, "KITTI root");
   cl.option("--sequence", &sequence, "sequence (default 0000)");
   cl.repeated("--detections", &detections, "detection file or directory");
+  cl.option("--detector", &detector,
+            "geometric | files: where every mode's DETECTIONS come from (as dlslot-run --detector; default: files "
+            "when there are any, else geometric)");
   cl.option("--scenario", &scenario, "simulate this scenario once, then compare on it");
   cl.option("--frames", &frames, "frames (simulated, or played)");
   cl.option("--seed", &seed, "simulator seed (default 1)");
@@ -135,7 +138,7 @@ int compare(int argc, char** argv) {
                                       "--seed", std::to_string(seed), "--sequence", sequence};
       if (frames > 0) sim.insert(sim.end(), {"--frames", std::to_string(frames)});
       runToEnd("dlslot-sim", sim);
-      detections = {root + "/detections/sim"};
+      if (detector != "geometric") detections = {root + "/detections/sim"};
       frames = -1;
     }
     std::vector<YAML::Node> metrics;
@@ -144,6 +147,7 @@ int compare(int argc, char** argv) {
       std::vector<std::string> a = {bin + "/dlslot-run", "--kitti", root, "--sequence", sequence, "--mode", mode,
                                     "--config", config, "--out", out + "/" + mode, "--no-render"};
       for (const auto& d : detections) a.insert(a.end(), {"--detections", d});
+      if (!detector.empty()) a.insert(a.end(), {"--detector", detector});
       if (frames > 0) a.insert(a.end(), {"--frames", std::to_string(frames)});
       if (!lcm_url.empty()) a.insert(a.end(), {"--lcm-url", lcm_url});
       runToEnd("dlslot-run --mode " + mode, a);
@@ -152,6 +156,9 @@ int compare(int argc, char** argv) {
 
     std::ostringstream md;
     md << "# Comparison on " << (scenario.empty() ? "KITTI " + root + " sequence " + sequence : "scenario " + scenario)
+       << "\n\nDetections: "
+       << (detector == "geometric" || (detector.empty() && detections.empty()) ? "dlslot-detector (geometric)"
+                                                                               : "files")
        << "\n\n## Table I: ego-motion and tracking accuracy\n\n"
        << "| mode | t_rel % (100-800 m) | r_rel deg/100m | t_rel % (10-80 m) | r_rel deg/100m (10-80 m) | ATE m | RPE1 m | "
           "RPE1 deg | MOTA | IDSW | velocity RMSE m/s |\n|---|---|---|---|---|---|---|---|---|---|---|\n";

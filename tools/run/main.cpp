@@ -1,6 +1,7 @@
 // dlslot-run: runs the whole DL-SLOT pipeline on one sequence and collects every output.
 //
-// Starts lcm-logger, the renderer, backend, tracker and odometry, waits until each reports on
+// Starts lcm-logger, the renderer, backend, tracker, odometry and (--detector geometric, the
+// default without detection files) dlslot-detector, waits until each reports on
 // PROCESS_STATUS, then plays the sequence (lockstep on SLOT_STATE by default). It watches every
 // process: one that dies, or a pipeline that stops making progress, ends the run with an error
 // naming the process and its last log lines. At the end it stops everything cleanly and runs the
@@ -36,6 +37,32 @@ ModeSettings settingsFor(const std::string& mode) {
   throw std::invalid_argument("--mode: expected slot, aloam, aloam-filtered or two-stage, got '" + mode + "'");
 }
 
+// Where DETECTIONS come from: "files" (the player plays detection files; a scenario's are the
+// simulator's) or "geometric" (dlslot-detector on the scans). Without --detector: files when
+// there are any (--detections, or a scenario's), else the geometric detector; said on stderr.
+std::string detectionSource(const std::string& requested, bool have_files, bool scenario) {
+  if (requested == "files") {
+    if (!have_files) std::cerr << "detections: --detector files without --detections: DETECTIONS stay empty\n";
+    return requested;
+  }
+  if (requested == "geometric") {
+    if (have_files && !scenario)
+      throw std::invalid_argument("--detector geometric and --detections exclude each other");
+    std::cerr << "detections: dlslot-detector (geometric) on the scans\n";
+    return requested;
+  }
+  if (!requested.empty())
+    throw std::invalid_argument("--detector: expected geometric or files, got '" + requested + "'");
+  if (have_files) {
+    std::cerr << "detections: " << (scenario ? "the simulator's" : "from --detections")
+              << " files (--detector geometric to detect from the scans instead)\n";
+    return "files";
+  }
+  std::cerr << "detections: no --detections given, so dlslot-detector (geometric) detects from the scans "
+               "(--detector files to run without detections)\n";
+  return "geometric";
+}
+
 std::string binDir() { return fs::read_symlink("/proc/self/exe").parent_path().string(); }
 
 // Runs a command to completion with output to log; returns its exit code.
@@ -51,7 +78,7 @@ struct Failure : std::runtime_error {
 };
 
 int runPipeline(int argc, char** argv) {
-  std::string root, sequence = "0000", scenario, mode = "slot", config = "config/dlslot.yaml", out, lcm_url;
+  std::string root, sequence = "0000", scenario, mode = "slot", config = "config/dlslot.yaml", out, lcm_url, detector;
   std::vector<std::string> detections;
   int frames = -1, seed = 1;
   double speed = 0, stall_s = 60, start_timeout_s = 30;
@@ -60,6 +87,9 @@ int runPipeline(int argc, char** argv) {
   cl.option("--kitti", &root, "KITTI root (holding training/ or sequences/)");
   cl.option("--sequence", &sequence, "sequence (default 0000)");
   cl.repeated("--detections", &detections, "detection file or directory");
+  cl.option("--detector", &detector,
+            "geometric (dlslot-detector on the scans) | files (--detections, a scenario's simulated ones); "
+            "default: files when there are any, else geometric");
   cl.option("--scenario", &scenario, "simulate this scenario (name or YAML) first, then run on it");
   cl.option("--frames", &frames, "frames to simulate (with --scenario) or to play (default: all)");
   cl.option("--seed", &seed, "simulator seed (default 1)");
@@ -77,6 +107,8 @@ int runPipeline(int argc, char** argv) {
   config = fs::absolute(findConfigFile(config)).string();  // the children get the same file from any directory
   if (root.empty() == scenario.empty()) throw std::invalid_argument("give either --kitti ROOT or --scenario NAME");
   const ModeSettings ms = settingsFor(mode);
+  const std::string source = detectionSource(detector, !detections.empty() || !scenario.empty(), !scenario.empty());
+  const bool geometric = source == "geometric";
   const std::string bin = binDir();
   fs::create_directories(out + "/logs");
   out = fs::canonical(out).string();
@@ -88,8 +120,8 @@ int runPipeline(int argc, char** argv) {
     ConfigSection cfg = loadConfig(config);  // throws a clear ConfigError
     (void)cfg;
     fs::copy_file(config, out + "/config.yaml", fs::copy_options::overwrite_existing);
-    for (const std::string p : {"player", "odometry", "tracker", "backend", "renderer"}) {
-      if (no_render && p == "renderer") continue;
+    for (const std::string p : {"player", "detector", "odometry", "tracker", "backend", "renderer"}) {
+      if ((no_render && p == "renderer") || (!geometric && p == "detector")) continue;
       const std::string log = logs + "/check-" + p + ".log";
       if (runToEnd(sup, "check-" + p, {bin + "/dlslot-" + p, "--config", config, "--check-config"}, log) != 0)
         throw ConfigError("dlslot-" + p + " refused the config:\n" + run::readText(log));
@@ -105,7 +137,7 @@ int runPipeline(int argc, char** argv) {
     std::cerr << "simulating " << scenario << " ...\n";
     if (runToEnd(sup, "sim", sim, logs + "/sim.log") != 0)
       throw Failure("dlslot-sim failed:\n" + sup.tail("sim"));
-    detections = {root + "/detections/sim"};
+    detections = geometric ? std::vector<std::string>{} : std::vector<std::string>{root + "/detections/sim"};
   }
   const int num_frames = kitti::locateSequence(root, sequence).num_frames;
   const int last_frame = (frames > 0 && scenario.empty()) ? std::min(frames, num_frames) - 1 : num_frames - 1;
@@ -135,6 +167,10 @@ int runPipeline(int argc, char** argv) {
   sup.start("backend", args(bin + "/dlslot-backend", {"--mode", ms.backend}), logs + "/backend.log");
   sup.start("tracker", args(bin + "/dlslot-tracker", {}), logs + "/tracker.log");
   sup.start("odometry", args(bin + "/dlslot-odometry", {"--mode", ms.odometry}), logs + "/odometry.log");
+  if (geometric) {
+    pipeline.push_back("detector");
+    sup.start("detector", args(bin + "/dlslot-detector", {}), logs + "/detector.log");
+  }
 
   std::map<std::string, process_status_t> health;
   int slot_frames = 0, slot_last = -1;
@@ -172,6 +208,7 @@ int runPipeline(int argc, char** argv) {
   std::vector<std::string> play = {"--kitti", root, "--sequence", sequence, "--quiet", "--delay", "0.2",
                                    "--end", std::to_string(last_frame)};
   for (const auto& d : detections) play.insert(play.end(), {"--detections", d});
+  if (geometric) play.push_back("--no-detections");
   if (speed > 0)
     play.insert(play.end(), {"--speed", std::to_string(speed)});
   else
@@ -216,8 +253,8 @@ int runPipeline(int argc, char** argv) {
 
   // 5. Stop in pipeline order so every process flushes (the renderer writes its summary, the
   // logger closes the log).
-  for (const std::string p : {"odometry", "tracker", "backend", "renderer"}) {
-    if (p == std::string("renderer") && no_render) continue;
+  for (const std::string p : {"detector", "odometry", "tracker", "backend", "renderer"}) {
+    if ((p == std::string("renderer") && no_render) || (p == std::string("detector") && !geometric)) continue;
     const int code = sup.stop(p, p == std::string("renderer") ? 60.0 : 10.0);
     if (code != 0) throw Failure(p + " did not exit cleanly (code " + std::to_string(code) + "):\n" + sup.tail(p));
   }

@@ -34,6 +34,10 @@ struct Box {
   bool contains(const Eigen::Vector3d& p, double margin = 0.0) const;
 };
 
+// The type of a detected box no class fits (dlslot-detector): published so the odometry removes
+// its points, never tracked (the tracker refuses it as a class type).
+inline constexpr const char* kUnknownType = "Unknown";
+
 // Everything the data set has for one scan.
 struct Frame {
   int index = 0;

@@ -1,0 +1,134 @@
+#include "detector/object_class.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dlslot::detector {
+
+namespace {
+
+// How far (in tan of elevation) below the top beam a cluster's highest point may be and still
+// count as cut off by it (the HDL-64E's top beams are 0.0058 apart).
+constexpr double kTopMargin = 0.006;
+// Within this range a van (2-2.5 m) reaches above the HDL-64E's top beam (1.73 m + 0.035 x range).
+constexpr double kBesideRange_m = 10.0;
+
+Eigen::Vector2d axisOf(double yaw) { return {std::cos(yaw), std::sin(yaw)}; }
+
+double logit(double p) {
+  p = std::clamp(p, 0.01, 0.995);
+  return std::log(p / (1 - p));
+}
+
+// Confidence from the evidence: enough points for the class, an L-shape with points on its edges
+// (vehicles), and how much of the box was seen rather than completed from the prior.
+double confidence(int points, double points_ref, double edge_fraction, double seen_share) {
+  const double support = 1.0 - std::exp(-points / points_ref);
+  return 0.5 + 0.5 * support * edge_fraction * (0.6 + 0.4 * std::clamp(seen_share, 0.0, 1.0));
+}
+
+Box makeBox(const Rectangle& r, const ClusterShape& s, const std::string& type, double score) {
+  Box b;
+  const double h = s.max_z - s.ground_z;
+  b.center = Eigen::Vector3d(r.center.x(), r.center.y(), s.ground_z + 0.5 * h);
+  b.size = Eigen::Vector3d(r.length, r.width, h);
+  b.yaw = r.yaw;
+  b.type = type;
+  b.score = score;
+  b.id = -1;
+  return b;
+}
+
+}  // namespace
+
+Rectangle completeVehicle(const Rectangle& seen, double prior_length_m, double prior_width_m, double side_min_m) {
+  Rectangle r = seen;
+  double seen_l = seen.length, seen_w = seen.width, yaw = seen.yaw;
+  const Eigen::Vector2d radial = seen.center.norm() > 1e-6 ? Eigen::Vector2d(seen.center.normalized()) : Eigen::Vector2d(1, 0);
+  // A face no wider than a car's back, across the line of sight: the back or the front (with the
+  // roof seen behind it, it may be a metre or more deep).
+  if (seen_l < side_min_m && seen_l <= prior_width_m + 0.4 && std::abs(axisOf(yaw).dot(radial)) < 0.7) {
+    std::swap(seen_l, seen_w);
+    yaw += M_PI / 2;
+  }
+  const double l = std::max(seen_l, prior_length_m), w = std::max(seen_w, prior_width_m);
+  const Eigen::Vector2d u = axisOf(yaw), v(-u.y(), u.x());
+  // Grow away from the sensor along each axis: the seen faces are the near ones.
+  const double su = u.dot(seen.center) >= 0 ? 1.0 : -1.0, sv = v.dot(seen.center) >= 0 ? 1.0 : -1.0;
+  r.center = seen.center + su * 0.5 * (l - seen_l) * u + sv * 0.5 * (w - seen_w) * v;
+  r.length = l;
+  r.width = w;
+  yaw = wrapAngle(yaw);
+  if (yaw > M_PI / 2) yaw -= M_PI;
+  if (yaw <= -M_PI / 2) yaw += M_PI;
+  r.yaw = yaw;
+  return r;
+}
+
+std::optional<Box> classifyCluster(const ClusterShape& s_in, const ClassConfig& cfg) {
+  ClusterShape s = s_in;
+  const double bottom = s.min_z - s.ground_z;
+  const Rectangle& seen = s.seen;
+  if (bottom > cfg.max_bottom_m) return std::nullopt;  // hangs above the ground: canopy, sign, overhang
+  const bool cut_at_top = s.max_tan >= cfg.top_tan - kTopMargin;
+  // Cut off by the top beam (beside the ego, up a slope), the seen height is only a lower bound: the
+  // windows' minimum heights do not apply, and the box is at least a car's height.
+  if (cut_at_top) s.max_z = std::max(s.max_z, s.ground_z + cfg.car.min_height_m);
+  const double h = s.max_z - s.ground_z;
+  // Poles and trunks: thin, and taller than a person or reaching the top beam.
+  if (seen.length <= cfg.pole_max_width_m && (cut_at_top || h > cfg.pedestrian.max_height_m)) return std::nullopt;
+  const double seen_area = seen.length * seen.width;
+
+  // A vehicle's side is not level (bonnet, roof, boot; a truck's cab below its box): a thin, level
+  // stretch as long as a side is a wall or a barrier, unless the top beam cut it off right beside
+  // the ego (a van there shows a level band). (A wide L-shape is a corner, level or not: a partly
+  // seen car shows only its roof's rear part.)
+  const bool cut_beside = cut_at_top && seen.center.norm() < kBesideRange_m;
+  const bool level_side = seen.length >= cfg.car_side_min_m && seen.width < cfg.level_max_width_m && !cut_beside &&
+                          s.profile_step < cfg.min_profile_step_m;
+  if (level_side) return std::nullopt;
+  // Tops that differ by more than a van's bonnet and roof: a tree or a bush, not a vehicle.
+  const bool ragged_top = s.profile_step > cfg.max_vehicle_profile_step_m;
+
+  // Vehicles seen whole (a van or a truck is its own prior).
+  if (!ragged_top && cfg.truck.contains(seen.length, seen.width, h, cut_at_top))
+    return makeBox(seen, s, "Truck", logit(confidence(s.num_points, 60, seen.edge_fraction, 1.0)));
+  if (!ragged_top && cfg.van.contains(seen.length, seen.width, h, cut_at_top))
+    return makeBox(seen, s, "Van", logit(confidence(s.num_points, 50, seen.edge_fraction, 1.0)));
+
+  // People: small footprint, person height, not cut off by the top beam (so not a pole or a wall).
+  const bool person_height = !cut_at_top;
+  if (person_height && cfg.pedestrian.contains(seen.length, seen.width, h))
+    return makeBox(seen, s, "Pedestrian", logit(confidence(s.num_points, 20, 1.0, 1.0)));
+  // A cyclist seen from the side: a bicycle's length, a person's height, narrow.
+  if (person_height && cfg.cyclist.contains(seen.length, seen.width, h) && h >= cfg.car.max_height_m - 0.3 &&
+      seen.length < cfg.car_side_min_m)
+    return makeBox(seen, s, "Cyclist", logit(confidence(s.num_points, 25, 1.0, 1.0)));
+
+  // Cars, also when partly seen: completed to the prior, then checked against the car window.
+  const bool vehicle_height = h >= cfg.car.min_height_m && h <= cfg.van.max_height_m;
+  if (vehicle_height && !ragged_top && seen.length >= cfg.min_vehicle_face_m && seen.length <= cfg.van.max_length_m && seen.width <= cfg.van.max_width_m) {
+    // Neither a side nor a back seen but a blob of both: a corner (an L) only when the points lie on
+    // its edges; foliage fills it.
+    const bool blob = seen.length < cfg.car_side_min_m && seen.width > 0.8;
+    if (blob && seen.edge_fraction < cfg.min_corner_edge_fraction)
+      return makeBox(seen, s, kUnknownType, logit(0.2));
+    // A wide cluster as long as a side still needs some of its points on the edges (foliage has
+    // almost none there).
+    if (seen.width > 0.8 && seen.edge_fraction < cfg.min_side_edge_fraction) return std::nullopt;
+    const Rectangle full = completeVehicle(seen, cfg.car_prior_length_m, cfg.car_prior_width_m, cfg.car_side_min_m);
+    const double share = seen_area / std::max(1e-6, full.length * full.width) +
+                         0.5 * std::max(seen.length, seen.width) / full.length;
+    const double score = logit(confidence(s.num_points, 40, std::max(0.3, seen.edge_fraction), share));
+    if (cfg.car.contains(full.length, full.width, h, cut_at_top)) return makeBox(full, s, "Car", score);
+    if (cfg.van.contains(full.length, full.width, h, cut_at_top)) return makeBox(full, s, "Van", score);
+  }
+
+  // Object-sized but no class: removed for the odometry, never tracked.
+  if (seen.length <= cfg.unknown_max_length_m && h >= cfg.unknown_min_height_m && h <= cfg.unknown_max_height_m &&
+      seen.length > cfg.pole_max_width_m)
+    return makeBox(seen, s, kUnknownType, logit(0.2));
+  return std::nullopt;
+}
+
+}  // namespace dlslot::detector

@@ -6,13 +6,16 @@
 #include <algorithm>
 #include <atomic>
 #include <csignal>
+#include <cstdlib>
 #include <cstdio>
 #include <iostream>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 
+#include "dlslot/frame_accounting.hpp"
 #include "dlslot/input_error.hpp"
+#include "dlslot/receive_buffer.hpp"
 
 namespace dlslot {
 
@@ -222,6 +225,19 @@ Node::Node(std::string name, const std::string& lcm_url, const Channels& channel
   if (!lcm_.good())
     throw std::runtime_error("cannot initialise LCM with URL '" +
                              (lcm_url.empty() ? std::string("(default)") : lcm_url) + "'");
+  const char* env = std::getenv("LCM_DEFAULT_URL");
+  const std::string url = !lcm_url.empty() ? lcm_url : env ? env : "";
+  if (const int64_t want = requestedReceiveBuffer(url); want > 0) {
+    lcm_.getFileno();  // creates LCM's receive socket (it is otherwise made on first use)
+    const ReceiveBuffer rb = enlargeLcmReceiveBuffer(lcmPort(url), want);
+    recv_fd_ = rb.fd;
+    status_.set("recv_buffer_bytes", rb.granted);
+    std::fprintf(stderr, "[%s] %s\n", name_.c_str(), rb.note.c_str());
+  }
+}
+
+void Node::noteFrameReceived(int frame) {
+  if (frames_received_.insert(frame).second) status_.count("frames_received");
 }
 
 void Node::subscribeRaw(const std::string& channel, RawHandler cb) {
@@ -241,7 +257,12 @@ void Node::after(double delay_s, std::function<void()> cb) {
                      0.0, std::move(cb)});
 }
 
-void Node::publishStatus() { publish(channels_.status, status_.toMessage()); }
+void Node::publishStatus() {
+  // The heartbeat carries the process's memory and the datagrams its socket lost.
+  status_.set("rss_kb", residentKb());
+  if (recv_fd_ >= 0) status_.set("udp_drops", std::max<int64_t>(0, udpDrops(recv_fd_)));
+  publish(channels_.status, status_.toMessage());
+}
 
 void Node::handleOnce(double max_wait_s) {
   // Wait for LCM traffic or the next timer, whichever comes first.

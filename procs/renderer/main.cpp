@@ -135,6 +135,7 @@ int renderLive(const NodeOptions& opts, const std::string& out, const RendererCo
   const int rc = node.run();
   sink.draw(state.takeAll());
   sink.finish();
+  node.publishStatus();  // the frames written after the loop ended count too
   const std::string summary = writer.writeSummary(state.summary());
   report(sink, out, summary, node.status());
   return rc;

@@ -20,8 +20,10 @@
 
 namespace {
 
+// In memory (tmpfs) where there is one: a file on disk costs most of an execution.
 const std::string& scratch() {
-  static const std::string path = "/tmp/dlslot-fuzz-" + std::to_string(getpid());
+  static const std::string path =
+      (access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp") + std::string("/dlslot-fuzz-") + std::to_string(getpid());
   return path;
 }
 

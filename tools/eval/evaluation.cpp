@@ -80,6 +80,8 @@ Metrics evaluate(RunData run, const EvalOptions& options) {
   if (run.kitti) m.kitti = evaluateKittiTracking({*run.kitti}, options.kitti);
   m.timing_ms = std::move(run.timing_ms);
   m.frame_counts = std::move(run.frame_counts);
+  m.frames = std::move(run.frames);
+  m.memory = std::move(run.memory);
   m.notes.insert(m.notes.end(), run.notes.begin(), run.notes.end());
   return m;
 }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "clear_mot.hpp"
+#include "dlslot/frame_accounting.hpp"
 #include "dlslot/timing_stats.hpp"
 #include "ego_metrics.hpp"
 #include "hota.hpp"
@@ -31,6 +32,8 @@ struct RunData {
   std::map<std::string, TimingStats> timing_ms;  // module -> per-frame processing time
   std::map<std::string, int64_t> frame_counts;   // channel -> messages in the log
   std::vector<std::string> notes;                // facts for the report (process health, warnings)
+  std::optional<FrameAccounting> frames;         // where every played frame went (a recorded run)
+  std::map<std::string, RssSummary> memory;      // process -> resident memory over the run
 };
 
 struct EvalOptions {
@@ -57,6 +60,8 @@ struct Metrics {
   std::map<std::string, TimingStats> timing_ms;
   std::map<std::string, int64_t> frame_counts;
   std::vector<std::string> notes;
+  std::optional<FrameAccounting> frames;
+  std::map<std::string, RssSummary> memory;
 };
 
 std::string primarySource(const std::map<std::string, Trajectory>& sources);

@@ -266,6 +266,12 @@ int run(int argc, char** argv) {
     run.timing_ms = log->timing_ms;
     run.frame_counts = log->frame_counts;
     addProcessNotes(*log, run);
+    std::vector<std::string> pipeline;
+    for (const std::string p : {"odometry", "tracker", "backend", "renderer"})
+      if (log->last_status.count(p)) pipeline.push_back(p);
+    run.frames = accountFrames(log->last_status, log->frame_counts[channels.scan], pipeline);
+    for (const auto& [process, samples] : log->rss_kb)
+      if (const auto r = summarizeRss(samples)) run.memory[process] = *r;
     if (!log->refused.empty()) {
       std::ostringstream n;
       int64_t total = 0;

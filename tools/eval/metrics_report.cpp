@@ -221,6 +221,26 @@ std::string metricsJson(const Metrics& m) {
     kv.emplace_back("timing_ms." + module + ".p95", num(s.count() ? Opt(s.percentile(95)) : std::nullopt));
   }
   for (const auto& [channel, n] : m.frame_counts) kv.emplace_back("frames." + channel, std::to_string(n));
+  if (m.frames) {
+    const FrameAccounting& f = *m.frames;
+    kv.emplace_back("frames.played", std::to_string(f.played));
+    for (const ProcessFrames& p : f.processes) {
+      kv.emplace_back("frames.received." + p.name, std::to_string(p.received));
+      kv.emplace_back("frames.handled." + p.name, std::to_string(p.handled));
+      kv.emplace_back("frames.skipped." + p.name, std::to_string(p.skipped));
+      kv.emplace_back("frames.lost." + p.name, std::to_string(p.lost));
+    }
+    kv.emplace_back("frames.lost", std::to_string(f.lost()));
+    kv.emplace_back("frames.without_odometry", std::to_string(f.without_odometry));
+    kv.emplace_back("frames.without_associations", std::to_string(f.without_associations));
+    kv.emplace_back("frames.without_detections", std::to_string(f.without_detections));
+    kv.emplace_back("frames.kernel_udp_drops", std::to_string(f.kernel_drops));
+  }
+  for (const auto& [process, r] : m.memory) {
+    kv.emplace_back("memory.rss_mb." + process + ".start", num(r.start_mb));
+    kv.emplace_back("memory.rss_mb." + process + ".middle", num(r.middle_mb));
+    kv.emplace_back("memory.rss_mb." + process + ".end", num(r.end_mb));
+  }
   std::string out = "{\n";
   for (size_t i = 0; i < kv.size(); ++i)
     out += "  " + quoted(kv[i].first) + ": " + kv[i].second + (i + 1 < kv.size() ? ",\n" : "\n");
@@ -281,6 +301,25 @@ std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plo
     out << "## Messages in the log\n\n";
     Table t({"channel", "messages"});
     for (const auto& [channel, n] : m.frame_counts) t.row({channel, std::to_string(n)});
+    out << t.render() << "\n";
+  }
+  if (m.frames) {
+    const FrameAccounting& f = *m.frames;
+    out << "## Frames per process\n\n" << f.played << " frames played.\n\n";
+    Table t({"process", "received", "handled", "skipped", "lost"});
+    for (const ProcessFrames& p : f.processes)
+      t.row({p.name, std::to_string(p.received), std::to_string(p.handled), std::to_string(p.skipped),
+             std::to_string(p.lost)});
+    out << t.render() << "\nSolved without odometry: " << f.without_odometry << "; without associations: "
+        << f.without_associations << "; without detections: " << f.without_detections
+        << "; UDP datagrams dropped by the kernel: " << f.kernel_drops << ".\n\n**" << f.verdict() << "**\n\n";
+  }
+  if (!m.memory.empty()) {
+    out << "## Memory (resident, MB)\n\n";
+    Table t({"process", "start", "middle", "end"});
+    char buf[32];
+    auto mb = [&](double v) { std::snprintf(buf, sizeof buf, "%.1f", v); return std::string(buf); };
+    for (const auto& [process, r] : m.memory) t.row({process, mb(r.start_mb), mb(r.middle_mb), mb(r.end_mb)});
     out << t.render() << "\n";
   }
   if (!m.notes.empty()) {

@@ -11,6 +11,7 @@
 #include "dlslot/associations_t.hpp"
 #include "dlslot/convert.hpp"
 #include "dlslot/detections_t.hpp"
+#include "dlslot/frame_accounting.hpp"
 #include "dlslot/ground_truth_t.hpp"
 #include "dlslot/input_error.hpp"
 #include "dlslot/message_guard.hpp"
@@ -149,6 +150,7 @@ class LogReader {
       const auto m = decode<process_status_t>(ev, index);
       if (!m) return;
       run_.last_status[m->name] = *m;
+      if (const int64_t kb = statusCounter(*m, "rss_kb"); kb > 0) run_.rss_kb[m->name].emplace_back(1e-6 * m->utime, kb);
       return;
     } else {
       return;

@@ -33,6 +33,8 @@ struct RunLog {
   std::map<std::string, int64_t> frame_counts;   // accepted messages per frame channel
   std::map<std::string, int64_t> refused;        // "CHANNEL.REASON" -> events skipped (message_guard.hpp)
   std::map<std::string, process_status_t> last_status;  // by process name
+  // Resident memory over the run by process: (PROCESS_STATUS utime in s, counter rss_kb).
+  std::map<std::string, std::vector<std::pair<double, int64_t>>> rss_kb;
 };
 
 // Reads every event; throws InputError naming the file for a missing, empty, truncated or corrupt

@@ -4,8 +4,11 @@
 // default without detection files) dlslot-detector, waits until each reports on
 // PROCESS_STATUS, then plays the sequence (lockstep on SLOT_STATE by default). It watches every
 // process: one that dies, or a pipeline that stops making progress, ends the run with an error
-// naming the process and its last log lines. At the end it stops everything cleanly and runs the
-// evaluator. Run it inside scripts/netns-run (./dlslot run does) unless --lcm-url is given.
+// naming the process and its last log lines; so does a process whose heartbeat (PROCESS_STATUS,
+// once a second) stops for --heartbeat-timeout seconds (stopped or hung). At the end it stops
+// everything cleanly, runs the evaluator, and accounts for every played frame per process
+// (frame_accounting.hpp): a run that lost frames says so in its last line and exits 4 unless
+// --allow-loss. Run it inside scripts/netns-run (./dlslot run does) unless --lcm-url is given.
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -13,10 +16,12 @@
 #include <thread>
 #include <algorithm>
 
+#include "dlslot/frame_accounting.hpp"
 #include "dlslot/kitti.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/process_status_t.hpp"
 #include "dlslot/progress.hpp"
+#include "dlslot/receive_buffer.hpp"
 #include "dlslot/slot_state_t.hpp"
 #include "supervisor.hpp"
 
@@ -81,8 +86,8 @@ int runPipeline(int argc, char** argv) {
   std::string root, sequence = "0000", scenario, mode = "slot", config = "config/dlslot.yaml", out, lcm_url, detector;
   std::vector<std::string> detections;
   int frames = -1, seed = 1;
-  double speed = 0, stall_s = 60, start_timeout_s = 30;
-  bool no_eval = false, no_render = false, quiet = false;
+  double speed = 0, stall_s = 60, start_timeout_s = 30, heartbeat_s = 10;
+  bool no_eval = false, no_render = false, quiet = false, allow_loss = false;
   CommandLine cl("dlslot-run", "Runs player, odometry, tracker, backend, renderer and lcm-logger on one sequence.");
   cl.option("--kitti", &root, "KITTI root (holding training/ or sequences/)");
   cl.option("--sequence", &sequence, "sequence (default 0000)");
@@ -99,6 +104,9 @@ int runPipeline(int argc, char** argv) {
   cl.option("--lcm-url", &lcm_url, "LCM URL for every process (default: $LCM_DEFAULT_URL)");
   cl.option("--speed", &speed, "rate mode at this real-time factor instead of lockstep");
   cl.option("--stall-timeout", &stall_s, "seconds without progress before the run fails (default 60)");
+  cl.option("--heartbeat-timeout", &heartbeat_s,
+            "seconds without a process's PROCESS_STATUS before it counts as stalled and the run fails (default 10)");
+  cl.flag("--allow-loss", &allow_loss, "exit 0 even when frames were lost (they are still reported)");
   cl.flag("--no-eval", &no_eval, "skip the evaluation");
   cl.flag("--no-render", &no_render, "do not start the renderer");
   cl.flag("--quiet", &quiet, "no progress line");
@@ -173,9 +181,18 @@ int runPipeline(int argc, char** argv) {
   }
 
   std::map<std::string, process_status_t> health;
+  std::map<std::string, Node::Clock::time_point> heard;               // last heartbeat per process
+  std::map<std::string, std::vector<std::pair<double, int64_t>>> rss;  // (s since start, kB) per process
   int slot_frames = 0, slot_last = -1;
-  auto last_progress = Node::Clock::now(), last_slot_time = last_progress;
-  node.subscribe<process_status_t>("PROCESS_STATUS", [&](const process_status_t& s) { health[s.name] = s; });
+  const auto run_start = Node::Clock::now();
+  auto last_progress = run_start, last_slot_time = last_progress;
+  node.subscribe<process_status_t>("PROCESS_STATUS", [&](const process_status_t& s) {
+    health[s.name] = s;
+    const auto now = Node::Clock::now();
+    heard[s.name] = now;
+    if (const int64_t kb = statusCounter(s, "rss_kb"); kb > 0)
+      rss[s.name].emplace_back(std::chrono::duration<double>(now - run_start).count(), kb);
+  });
   node.subscribeFrames<slot_state_t>("SLOT_STATE", [&](const slot_state_t& s) {
     ++slot_frames;
     slot_last = s.frame;
@@ -205,6 +222,20 @@ int runPipeline(int argc, char** argv) {
   }
 
   // 4. Play, watching every process.
+  const int64_t kernel_drops_before = udpReceiveBufferErrors();
+  // A process whose heartbeat stopped: SIGSTOP, an endless loop, a deadlock.
+  auto failIfSilent = [&] {
+    const auto now = Node::Clock::now();
+    for (const auto& p : pipeline) {
+      const auto it = heard.find(p);
+      if (it == heard.end() || std::chrono::duration<double>(now - it->second).count() <= heartbeat_s) continue;
+      const auto h = health.find(p);
+      throw Failure(p + " stalled: no PROCESS_STATUS (heartbeat) for " + std::to_string(int(heartbeat_s)) +
+                    " s though it is still running (stopped or hung); its last frame " +
+                    std::to_string(h == health.end() ? -1 : h->second.last_frame) + "; its last lines (" +
+                    sup.logPath(p) + "):\n" + sup.tail(p));
+    }
+  };
   std::vector<std::string> play = {"--kitti", root, "--sequence", sequence, "--quiet", "--delay", "0.2",
                                    "--end", std::to_string(last_frame)};
   for (const auto& d : detections) play.insert(play.end(), {"--detections", d});
@@ -237,6 +268,7 @@ int runPipeline(int argc, char** argv) {
   while (sup.running("player") || slot_last < last_frame) {
     if (signalReceived()) throw Failure("interrupted");
     failIfDead("player");
+    failIfSilent();
     const double idle = std::chrono::duration<double>(Node::Clock::now() - last_progress).count();
     if (idle > stall_s) {
       std::string detail;
@@ -253,9 +285,11 @@ int runPipeline(int argc, char** argv) {
 
   // 5. Stop in pipeline order so every process flushes (the renderer writes its summary, the
   // logger closes the log).
+  // The launcher keeps reading while it waits, so each process's last PROCESS_STATUS is heard.
+  const auto listen = [&] { node.spinUntil([] { return false; }, 0.02); };
   for (const std::string p : {"detector", "odometry", "tracker", "backend", "renderer"}) {
     if ((p == std::string("renderer") && no_render) || (p == std::string("detector") && !geometric)) continue;
-    const int code = sup.stop(p, p == std::string("renderer") ? 60.0 : 10.0);
+    const int code = sup.stop(p, p == std::string("renderer") ? 60.0 : 10.0, listen);
     if (code != 0) throw Failure(p + " did not exit cleanly (code " + std::to_string(code) + "):\n" + sup.tail(p));
   }
   node.spinUntil([] { return false; }, 0.3);
@@ -265,6 +299,18 @@ int runPipeline(int argc, char** argv) {
   std::fprintf(stderr, "SLOT_STATE for %d of %d frames; pipeline rate %.2f frames/s (%s)\n", slot_frames,
                last_frame + 1, play_s > 0 ? slot_frames / play_s : 0.0, speed > 0 ? "rate mode" : "lockstep");
   if (slot_frames != last_frame + 1) std::cerr << "warning: frames are missing from SLOT_STATE\n";
+  // Where every frame went, and the memory of each process over the run.
+  FrameAccounting accounting = accountFrames(health, last_frame + 1, std::vector<std::string>(pipeline.rbegin(), pipeline.rend()));
+  if (const int64_t after = udpReceiveBufferErrors(); after >= 0 && kernel_drops_before >= 0)
+    accounting.kernel_drops = std::max(accounting.kernel_drops, after - kernel_drops_before);  // the logger's too
+  std::cerr << accounting.table();
+  std::cerr << "memory (RSS MB, start / middle / end):\n";
+  for (const auto& [p, samples] : rss)
+    if (const auto r = summarizeRss(samples)) {
+      char line[128];
+      std::snprintf(line, sizeof line, "  %-10s %7.1f %7.1f %7.1f\n", p.c_str(), r->start_mb, r->middle_mb, r->end_mb);
+      std::cerr << line;
+    }
   if (const auto refused = node.status().refusals(); !refused.empty()) {
     std::string what;
     int64_t total = 0;
@@ -284,6 +330,9 @@ int runPipeline(int argc, char** argv) {
   }
   std::cout << "outputs in " << out << ": run.lcmlog, trajectory_*.txt, tracks_kitti.txt, metrics.json, report.md, "
             << (no_render ? "" : "bev/, ") << "plots/, config.yaml, logs/\n";
+  std::cout << std::flush;
+  std::cerr << "dlslot-run: " << accounting.verdict() << "\n";
+  if (accounting.hasLoss() && !allow_loss) return 4;
   return 0;
 }
 

@@ -72,14 +72,18 @@ std::optional<Supervisor::Exit> Supervisor::reap() {
 
 bool Supervisor::running(const std::string& name) { return !poll(find(name)); }
 
-int Supervisor::stop(const std::string& name, double grace_s) {
+int Supervisor::stop(const std::string& name, double grace_s, const std::function<void()>& idle) {
   Child& c = find(name);
   c.reported = true;  // stopped on purpose: the caller gets the code
   if (!running(name)) return c.code;
   kill(c.pid, SIGINT);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(grace_s);
-  while (running(name) && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  while (running(name) && std::chrono::steady_clock::now() < deadline) {
+    if (idle)
+      idle();
+    else
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
   if (running(name)) {
     kill(c.pid, SIGKILL);
     int status = 0;

@@ -5,6 +5,7 @@
 
 #include <sys/types.h>
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -31,7 +32,8 @@ class Supervisor {
   bool running(const std::string& name);
 
   // SIGINT to `name`, SIGKILL after grace_s; returns its exit code (128 + signal when killed).
-  int stop(const std::string& name, double grace_s = 5.0);
+  // `idle` (if given) is called repeatedly while waiting, instead of sleeping.
+  int stop(const std::string& name, double grace_s = 5.0, const std::function<void()>& idle = {});
   // Stops every running child, newest first.
   void stopAll(double grace_s = 5.0);
 

@@ -10,6 +10,7 @@
 #include <list>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -72,6 +73,7 @@ class ProcessStatus {
   void error(const std::string& what);
   void warn(const std::string& what);  // logged to stderr and kept as last_warning
   void count(const std::string& counter, int64_t by = 1);
+  void set(const std::string& counter, int64_t value) { counters_[counter] = value; }
   int64_t counter(const std::string& counter) const;
   int64_t framesHandled() const { return frames_; }
   process_status_t toMessage() const;
@@ -90,7 +92,10 @@ class Node {
  public:
   using Clock = std::chrono::steady_clock;
 
-  // Throws std::runtime_error naming the URL when LCM cannot be initialised.
+  // Throws std::runtime_error naming the URL when LCM cannot be initialised. When the URL (or
+  // $LCM_DEFAULT_URL) asks for recv_buf_size, the receive socket is made at once and its buffer
+  // enlarged past net.core.rmem_max where allowed (receive_buffer.hpp); the size granted is
+  // logged and reported as the counter recv_buffer_bytes.
   Node(std::string name, const std::string& lcm_url, const Channels& channels = Channels());
 
   lcm::LCM& lcm() { return lcm_; }
@@ -128,6 +133,7 @@ class Node {
 
  private:
   void handleOnce(double max_wait_s);
+  void noteFrameReceived(int frame);
   struct Timer {
     Clock::time_point next;
     double period_s;  // 0 = one-shot
@@ -139,6 +145,8 @@ class Node {
   ProcessStatus status_;
   std::vector<Timer> timers_;
   std::map<std::string, FrameOrder> frame_order_;
+  std::set<int> frames_received_;  // distinct frames that any frame channel carried
+  int recv_fd_ = -1;               // LCM's receive socket, for its kernel drop count
   std::list<RawHandler> handlers_;  // stable addresses: LCM keeps a pointer to each
   bool stop_ = false;
 };
@@ -179,6 +187,7 @@ void Node::subscribeFrames(const std::string& channel, std::function<void(const 
     }
     // Frames are within [0, kMaxFrame] here, so neither `last + 1` nor the gap overflows.
     if (last >= 0 && msg.frame > last + 1) status_.frameGap(channel, last + 1, msg.frame);
+    noteFrameReceived(msg.frame);
     cb(msg);
   });
 }

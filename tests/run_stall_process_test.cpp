@@ -1,0 +1,76 @@
+// Issue 17, item 2: a stall is seen per process, not only for the whole pipeline. The odometry is
+// stopped with SIGSTOP mid-run (alive, silent, holding its frames); the launcher must name it as
+// stalled once its heartbeat (PROCESS_STATUS, 1 Hz) has been missing for --heartbeat-timeout
+// seconds, exit 3, and leave nothing running.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "process_harness.hpp"
+
+using namespace dlslot::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+// The pid of the child of `parent` running `comm`, or -1.
+pid_t childNamed(pid_t parent, const std::string& comm) {
+  for (const auto& e : fs::directory_iterator("/proc")) {
+    const std::string name = e.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream stat(e.path() / "stat");
+    std::string text;
+    if (!std::getline(stat, text)) continue;
+    const auto open = text.find('('), close = text.rfind(')');
+    if (open == std::string::npos || close == std::string::npos) continue;
+    std::istringstream rest(text.substr(close + 2));
+    char state = 0;
+    pid_t ppid = 0;
+    rest >> state >> ppid;
+    if (ppid == parent && text.substr(open + 1, close - open - 1) == comm) return std::stoi(name);
+  }
+  return -1;
+}
+
+}  // namespace
+
+TEST(RunStallProcess, StoppedOdometryIsReportedByName) {
+  ASSERT_TRUE(insidePrivateNetwork());
+  const std::string out = scratchDir();
+  ChildProcess sim({bin("dlslot-sim"), "--scenario", "intersection", "--frames", "40", "--seed", "3", "--out",
+                    out + "/data"},
+                   out + "/sim.log");
+  ASSERT_EQ(sim.wait(300), 0) << sim.output();
+  // Rate mode at a quarter of real time (40 frames in 16 s): the odometry is stopped mid-run, long
+  // before the pipeline-wide stall timeout (60 s) could fire.
+  ChildProcess run({bin("dlslot-run"), "--config", config(), "--kitti", out + "/data", "--detections",
+                    out + "/data/detections/sim", "--out", out + "/run", "--speed", "0.25", "--quiet", "--no-render",
+                    "--no-eval", "--heartbeat-timeout", "3"},
+                   out + "/run.log");
+  for (int i = 0; i < 600 && !fs::exists(out + "/run/logs/player.log"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  ASSERT_TRUE(run.running()) << run.output();
+  const pid_t odometry = childNamed(run.pid(), "dlslot-odometry");
+  ASSERT_GT(odometry, 0) << run.output();
+
+  const auto stopped_at = std::chrono::steady_clock::now();
+  ASSERT_EQ(kill(odometry, SIGSTOP), 0);
+  const int code = run.wait(60);
+  const double after_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - stopped_at).count();
+  const std::string text = run.output();
+  EXPECT_EQ(code, 3) << text;
+  EXPECT_NE(text.find("odometry stalled: no PROCESS_STATUS (heartbeat) for 3 s"), std::string::npos) << text;
+  EXPECT_EQ(text.find("pipeline stalled"), std::string::npos) << text;
+  EXPECT_LT(after_s, 20.0) << "the stall took " << after_s << " s to be reported";
+  // The stopped process was ended with the run (SIGKILL reaches a stopped process).
+  for (int i = 0; i < 100 && kill(odometry, 0) == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const bool gone = kill(odometry, 0) != 0;
+  if (!gone) kill(odometry, SIGKILL);
+  EXPECT_TRUE(gone) << "the stopped odometry outlived the launcher";
+  std::cout << "[ stall ] odometry SIGSTOPped; the launcher reported it by name after " << after_s << " s (exit "
+            << code << ")\n";
+}

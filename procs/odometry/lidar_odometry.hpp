@@ -66,6 +66,7 @@ class LidarOdometry {
   Pose velocity_ = Pose::Identity();           // the last delta: constant-velocity model
   bool started_ = false;
   bool moving_ = false;                        // velocity_ comes from a registration
+  int fallbacks_ = 0;                          // consecutive fallback frames (fallback_motion.hpp)
 };
 
 }  // namespace dlslot::odometry

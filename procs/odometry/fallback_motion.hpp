@@ -1,0 +1,38 @@
+// The odometry's guess while it cannot register (fallback frames), and its way back.
+//
+// A fallback publishes the constant-velocity prediction. Kept up for long, a stale velocity runs
+// the guess away without bound (a vehicle that stopped while its scans were lost "drives on"
+// for metres), and the jump guard then rejects every correct registration once scans return. So
+// the velocity is kept whole for a few frames only (a scan or two lost while driving), then
+// decays towards standing still; and after fallbacks a registration is taken again when scan-to-map
+// agrees with scan-to-scan (the motion from the last registered scan), however far the guess drifted.
+#pragma once
+
+#include <Eigen/Geometry>
+
+#include "dlslot/types.hpp"
+
+namespace dlslot::odometry {
+
+// Consecutive fallback frames that keep the last velocity whole.
+constexpr int kFallbackHoldFrames = 3;
+// Per further fallback frame the velocity is multiplied by this: the guess then moves at most
+// kFallbackDecay / (1 - kFallbackDecay) ~ 2.3 frames' worth further, however long the scans stay away.
+constexpr double kFallbackDecay = 0.7;
+
+// The rigid motion T scaled by f: its rotation angle and translation times f (exact for straight
+// driving, close for the small turns of a frame or a few).
+inline Pose scaledMotion(const Pose& T, double f) {
+  const Eigen::AngleAxisd aa(T.linear());
+  Pose out = Pose::Identity();
+  out.linear() = Eigen::AngleAxisd(f * aa.angle(), aa.axis()).toRotationMatrix();
+  out.translation() = f * T.translation();
+  return out;
+}
+
+// The velocity for the frame after the `fallbacks`-th consecutive fallback frame.
+inline Pose fallbackVelocity(const Pose& velocity, int fallbacks) {
+  return fallbacks < kFallbackHoldFrames ? velocity : scaledMotion(velocity, kFallbackDecay);
+}
+
+}  // namespace dlslot::odometry

@@ -1,7 +1,8 @@
 // After a stretch of fallback frames the odometry comes back: the guess stops running on with a
 // stale velocity, and once scans return a registration that scan-to-map and scan-to-scan agree on
 // is taken however far the guess drifted (the 1000-frame highway soak stayed in fallback for its
-// last 497 frames). A single solution far from a good prediction is still rejected.
+// last 497 frames), whether the vehicle stopped or drove on meanwhile. A single solution far from
+// a good prediction is still rejected.
 #include <gtest/gtest.h>
 
 #include "odometry/fallback_motion.hpp"
@@ -66,6 +67,25 @@ TEST(OdometryFallbackRecovery, StopsDuringADropoutAndRecoversWhenScansReturn) {
   }
   ASSERT_GE(first_ok_after, 24) << "never recovered";
   EXPECT_LE(first_ok_after, 26) << "recovered only at frame " << first_ok_after;
+}
+
+// The vehicle keeps driving 1.5 m a frame through 10 lost scans: the published guess has come to
+// rest far behind it, and the scan-to-scan started from the old velocity kept up finds it again
+// (a periodic street: started from the resting guess it would lock onto the wrong block).
+TEST(OdometryFallbackRecovery, KeepsItsSpeedThroughADropoutAndRecovers) {
+  const test::Scene street = test::street();
+  LidarOdometry odometry;
+  for (int i = 0; i < 19; ++i) {
+    const Pose T = test::planarPose(1.5 * i, 0.0, 0.0);
+    const bool lost = i >= 6 && i < 16;
+    const OdometryResult r = odometry.process(frameOf(i, lost ? PointCloud(4, 0) : street.scan(T)));
+    if (lost) continue;
+    EXPECT_EQ(r.status, i == 0 ? Status::FirstFrame : Status::Ok) << "frame " << i << ": " << r.status_text;
+    EXPECT_LT((r.T_world_lidar.translation() - T.translation()).norm(), 0.1) << "frame " << i;
+    if (i == 16) {
+      EXPECT_NE(r.status_text.find("re-anchored"), std::string::npos) << r.status_text;
+    }
+  }
 }
 
 // One scan far from a good prediction (as from a registration gone wrong) is kept out by the jump

@@ -4,8 +4,10 @@
 // the guess away without bound (a vehicle that stopped while its scans were lost "drives on"
 // for metres), and the jump guard then rejects every correct registration once scans return. So
 // the velocity is kept whole for a few frames only (a scan or two lost while driving), then
-// decays towards standing still; and after fallbacks a registration is taken again when scan-to-map
-// agrees with scan-to-scan (the motion from the last registered scan), however far the guess drifted.
+// decays towards standing still. When scans return, scan-to-scan starts from both that resting
+// guess and the old velocity kept up (the vehicle may have stopped or driven on), and a
+// registration is taken again when scan-to-map agrees with scan-to-scan (the motion from the last
+// registered scan), however far it is from the published guess.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -28,6 +30,13 @@ inline Pose scaledMotion(const Pose& T, double f) {
   out.linear() = Eigen::AngleAxisd(f * aa.angle(), aa.axis()).toRotationMatrix();
   out.translation() = f * T.translation();
   return out;
+}
+
+// `step` n times in a row: the motion over n frames at constant velocity.
+inline Pose steps(const Pose& step, int n) {
+  Pose T = Pose::Identity();
+  for (int i = 0; i < n; ++i) T = T * step;
+  return T;
 }
 
 // The velocity for the frame after the `fallbacks`-th consecutive fallback frame.

@@ -45,6 +45,7 @@ void LidarOdometry::reset() {
   T_world_reference_ = T_world_last_ = velocity_ = Pose::Identity();
   started_ = moving_ = false;
   fallbacks_ = 0;
+  registered_velocity_ = Pose::Identity();
 }
 
 void LidarOdometry::fallBack(Status status, const std::string& why, const Pose& prediction, OdometryResult& out) {
@@ -105,6 +106,16 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
   if (started_) {
     s2s = moving_ ? registerScanToScan(features, reference_, T_world_reference_.inverse() * prediction, cfg_.scan_to_scan)
                   : registerFirstMotion(features, reference_, cfg_.scan_to_scan);
+    // Back from fallbacks the prediction rests (fallback_motion.hpp) but the vehicle may have kept
+    // its speed: scan-to-scan from there too, and the solution explaining more of the scan wins.
+    if (fallbacks_ > 0 && moving_) {
+      const Registration kept = registerScanToScan(features, reference_, steps(registered_velocity_, fallbacks_ + 1),
+                                                   cfg_.scan_to_scan);
+      const double match_ms = s2s.match_ms + kept.match_ms, solve_ms = s2s.solve_ms + kept.solve_ms;
+      if (kept.solution.ok && (!s2s.solution.ok || kept.solution.num_inliers > s2s.solution.num_inliers)) s2s = kept;
+      s2s.match_ms = match_ms;
+      s2s.solve_ms = solve_ms;
+    }
     out.detail.emplace_back("s2s_match", s2s.match_ms);
     out.detail.emplace_back("s2s_solve", s2s.solve_ms);
     out.timings.emplace_back("scan_to_scan", msSince(t));
@@ -174,7 +185,8 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
   if (started_) {
     // After fallbacks the last published pose was a guess: the velocity is the mean motion since
     // the last registered scan instead.
-    velocity_ = fallbacks_ > 0 ? scaledMotion(T_world_reference_.inverse() * pose, 1.0 / (fallbacks_ + 1)) : out.delta;
+    velocity_ = registered_velocity_ =
+        fallbacks_ > 0 ? scaledMotion(T_world_reference_.inverse() * pose, 1.0 / (fallbacks_ + 1)) : out.delta;
     moving_ = true;
   }
   fallbacks_ = 0;

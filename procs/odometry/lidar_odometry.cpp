@@ -156,8 +156,9 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
       failure = "scan-to-map failed (" + std::to_string(s2m.num_correspondences) + " correspondences)";
     else if (jumped && !anchored)
       failure = "solution jumped " + std::to_string(correction.translation().norm()) + " m from the prediction";
-    else if (jumped)
-      out.status_text = "re-anchored after " + std::to_string(fallbacks_) + " fallback frames, " +
+    else if (fallbacks_ > 0)  // registered again: said once, for the logs
+      out.status_text = std::string(jumped ? "re-anchored" : "registered again") + " after " +
+                        std::to_string(fallbacks_) + " fallback frames, " +
                         std::to_string(correction.translation().norm()) + " m from the prediction";
     if (!failure.empty()) {
       out.timings.emplace_back("scan_to_map", msSince(t));

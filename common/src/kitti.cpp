@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -106,6 +108,15 @@ std::FILE* openWrite(const std::string& path) {
   return f;
 }
 
+// Closes a file opened by openWrite and throws if any of its writes failed: a full disk (or a
+// file size limit) otherwise leaves empty or truncated files behind without a word.
+void closeWrite(std::FILE* f, const std::string& path) {
+  const bool failed = std::ferror(f) != 0;
+  const int err = errno;
+  if (std::fclose(f) != 0 || failed)
+    throw InputError(path, 0, std::string("writing failed: ") + std::strerror(failed ? err : errno));
+}
+
 Eigen::Matrix3d rpyToR(double roll, double pitch, double yaw) {
   return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
@@ -176,7 +187,7 @@ void writeCalib(const std::string& path, const Calib& calib) {
     writeRows(f, calib.T_velo_imu->matrix().topRows<3>());
     std::fprintf(f, "\n");
   }
-  std::fclose(f);
+  closeWrite(f, path);
 }
 
 // ---------------- velodyne ----------------
@@ -202,9 +213,10 @@ PointCloud readVelodyne(const std::string& path) {
 }
 
 void writeVelodyne(const std::string& path, const PointCloud& scan) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw InputError(path, 0, "cannot open file for writing");
-  out.write(reinterpret_cast<const char*>(scan.data()), scan.size() * sizeof(float));
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) throw InputError(path, 0, "cannot open file for writing");
+  std::fwrite(scan.data(), sizeof(float), static_cast<size_t>(scan.size()), f);
+  closeWrite(f, path);
 }
 
 // ---------------- boxes ----------------
@@ -274,7 +286,7 @@ void writeTrackingLabels(const std::string& path, const std::vector<LabelRow>& r
     if (r.score) std::fprintf(f, " %.6f", *r.score);
     std::fprintf(f, "\n");
   }
-  std::fclose(f);
+  closeWrite(f, path);
 }
 
 // ---------------- results rows: the box in the image ----------------
@@ -430,7 +442,7 @@ void writeOxts(const std::string& path, const std::vector<OxtsRecord>& rows) {
     for (int i = 0; i < 30; ++i) std::fprintf(f, i < 25 ? "%s%.14g" : "%s%.0f", i ? " " : "", r[i]);
     std::fprintf(f, "\n");
   }
-  std::fclose(f);
+  closeWrite(f, path);
 }
 
 std::vector<Pose> oxtsToLidarPoses(const std::vector<OxtsRecord>& rows, const Pose& T_velo_imu) {
@@ -512,7 +524,7 @@ void writePoses(const std::string& path, const std::vector<Pose>& poses) {
     for (int i = 0; i < 12; ++i) std::fprintf(f, i ? " %.12e" : "%.12e", m(i / 4, i % 4));
     std::fprintf(f, "\n");
   }
-  std::fclose(f);
+  closeWrite(f, path);
 }
 
 std::vector<double> readTimes(const std::string& path) {

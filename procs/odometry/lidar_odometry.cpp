@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "dlslot/box_filter.hpp"
+#include "fallback_motion.hpp"
 #include "rigid_motion.hpp"
 #include "scan_to_map.hpp"
 
@@ -43,6 +44,8 @@ void LidarOdometry::reset() {
   reference_ = ScanReference();
   T_world_reference_ = T_world_last_ = velocity_ = Pose::Identity();
   started_ = moving_ = false;
+  fallbacks_ = 0;
+  registered_velocity_ = Pose::Identity();
 }
 
 void LidarOdometry::fallBack(Status status, const std::string& why, const Pose& prediction, OdometryResult& out) {
@@ -52,6 +55,7 @@ void LidarOdometry::fallBack(Status status, const std::string& why, const Pose& 
   out.delta = T_world_last_.inverse() * prediction;
   out.covariance = fallbackCovariance(cfg_);
   T_world_last_ = prediction;
+  velocity_ = fallbackVelocity(velocity_, ++fallbacks_);
 }
 
 OdometryResult LidarOdometry::process(const Frame& frame, bool detections_available) {
@@ -102,6 +106,16 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
   if (started_) {
     s2s = moving_ ? registerScanToScan(features, reference_, T_world_reference_.inverse() * prediction, cfg_.scan_to_scan)
                   : registerFirstMotion(features, reference_, cfg_.scan_to_scan);
+    // Back from fallbacks the prediction rests (fallback_motion.hpp) but the vehicle may have kept
+    // its speed: scan-to-scan from there too, and the solution explaining more of the scan wins.
+    if (fallbacks_ > 0 && moving_) {
+      const Registration kept = registerScanToScan(features, reference_, steps(registered_velocity_, fallbacks_ + 1),
+                                                   cfg_.scan_to_scan);
+      const double match_ms = s2s.match_ms + kept.match_ms, solve_ms = s2s.solve_ms + kept.solve_ms;
+      if (kept.solution.ok && (!s2s.solution.ok || kept.solution.num_inliers > s2s.solution.num_inliers)) s2s = kept;
+      s2s.match_ms = match_ms;
+      s2s.solve_ms = solve_ms;
+    }
     out.detail.emplace_back("s2s_match", s2s.match_ms);
     out.detail.emplace_back("s2s_solve", s2s.solve_ms);
     out.timings.emplace_back("scan_to_scan", msSince(t));
@@ -129,12 +143,23 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
     out.detail.emplace_back("s2m_match", s2m.match_ms);
     out.detail.emplace_back("s2m_solve", s2m.solve_ms);
     const Pose correction = prediction.inverse() * s2m.solution.T_ref_cur;
+    // After fallbacks the prediction is a guess: a solution far from it is taken when scan-to-map
+    // agrees with scan-to-scan (re-anchoring); otherwise one bad solution is kept out.
+    auto beyond = [&](const Pose& c) {
+      return c.translation().norm() > cfg_.max_correction_m || angleOf(c) > cfg_.max_correction_deg * M_PI / 180.0;
+    };
+    const Pose s2s_pose = T_world_reference_ * s2s.solution.T_ref_cur;
+    const bool jumped = moving_ && beyond(correction);
+    const bool anchored = fallbacks_ > 0 && !beyond(s2s_pose.inverse() * s2m.solution.T_ref_cur);
     std::string failure;
     if (!s2m.solution.ok)
       failure = "scan-to-map failed (" + std::to_string(s2m.num_correspondences) + " correspondences)";
-    else if (moving_ && (correction.translation().norm() > cfg_.max_correction_m ||
-                         angleOf(correction) > cfg_.max_correction_deg * M_PI / 180.0))
+    else if (jumped && !anchored)
       failure = "solution jumped " + std::to_string(correction.translation().norm()) + " m from the prediction";
+    else if (fallbacks_ > 0)  // registered again: said once, for the logs
+      out.status_text = std::string(jumped ? "re-anchored" : "registered again") + " after " +
+                        std::to_string(fallbacks_) + " fallback frames, " +
+                        std::to_string(correction.translation().norm()) + " m from the prediction";
     if (!failure.empty()) {
       out.timings.emplace_back("scan_to_map", msSince(t));
       fallBack(Status::FallbackSolveFailed, failure, prediction, out);
@@ -159,9 +184,13 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
   out.T_world_lidar = pose;
   out.delta = T_world_last_.inverse() * pose;
   if (started_) {
-    velocity_ = out.delta;
+    // After fallbacks the last published pose was a guess: the velocity is the mean motion since
+    // the last registered scan instead.
+    velocity_ = registered_velocity_ =
+        fallbacks_ > 0 ? scaledMotion(T_world_reference_.inverse() * pose, 1.0 / (fallbacks_ + 1)) : out.delta;
     moving_ = true;
   }
+  fallbacks_ = 0;
   T_world_last_ = T_world_reference_ = pose;
   const auto t_index = Clock::now();
   reference_.reset(features);

@@ -66,6 +66,8 @@ class LidarOdometry {
   Pose velocity_ = Pose::Identity();           // the last delta: constant-velocity model
   bool started_ = false;
   bool moving_ = false;                        // velocity_ comes from a registration
+  int fallbacks_ = 0;                          // consecutive fallback frames (fallback_motion.hpp)
+  Pose registered_velocity_ = Pose::Identity();  // velocity_ at the last registration (never decayed)
 };
 
 }  // namespace dlslot::odometry

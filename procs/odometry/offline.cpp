@@ -47,7 +47,7 @@ int runOffline(const OfflineOptions& opts, const OdometryConfig& cfg) {
     const OdometryResult r = odometry.process(reader.read(i), !opts.detections.empty());
     poses.push_back(r.T_world_lidar);
     ++statuses[r.status];
-    if (r.status == Status::FallbackFewPoints || r.status == Status::FallbackSolveFailed)
+    if (!r.status_text.empty())  // fallbacks, and the first frame registered after them
       std::fprintf(stderr, "\nframe %d: %s: %s\n", i, statusName(r.status), r.status_text.c_str());
     removed += r.num_points_removed;
     if (r.status == Status::Ok) {

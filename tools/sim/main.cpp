@@ -47,6 +47,12 @@ int main(int argc, char** argv) {
         "%d objects (%d removed as overlapping), %d tracks, ego path %.0f m\n",
         sc.name.c_str(), out.c_str(), sequence.c_str(), st.frames, st.seconds, 1000 * st.seconds / st.frames,
         st.mean_points, st.objects, st.removed, st.labelled_tracks, st.path_length_m);
+    if (st.ego_path_end_frame >= 0)
+      std::fprintf(stderr,
+                   "dlslot-sim: note: the ego reaches the end of its path and stands there from frame %d on "
+                   "(scenario %s is written for %d frames); its scans still see the ground, the roadside and the "
+                   "traffic\n",
+                   st.ego_path_end_frame, sc.name.c_str(), sc.frames);
   } catch (const std::exception& e) {  // ConfigError, InputError (files), runtime errors (scenario)
     std::fprintf(stderr, "dlslot-sim: %s\n", e.what());
     return 1;

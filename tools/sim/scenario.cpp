@@ -365,6 +365,8 @@ void writeScenario(const std::string& path, const Scenario& scenario) {
   if (!f) throw ConfigError(path + ": cannot open for writing");
   f << "# The scenario this sequence was made from (" << scenario.file << "), with the seed and frame count used.\n"
     << out << "\n";
+  f.close();
+  if (!f) throw ConfigError(path + ": writing failed");
 }
 
 }  // namespace dlslot::sim

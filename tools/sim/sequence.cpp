@@ -33,6 +33,7 @@ SequenceStats writeSequence(const Scenario& scenario_in, int frames, uint64_t se
   stats.frames = frames;
   stats.objects = static_cast<int>(sim.motion().agents.size());
   stats.removed = sim.motion().removed;
+  stats.ego_path_end_frame = sim.motion().ego_path_end_frame;
   std::vector<kitti::LabelRow> labels, detections;
   ProgressLine progress("dlslot-sim " + scenario.name, frames);
   double points = 0;

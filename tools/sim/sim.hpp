@@ -26,6 +26,7 @@ struct SequenceStats {
   int removed = 0;           // objects dropped because their paths would overlap
   int labelled_tracks = 0;   // track ids given
   double path_length_m = 0;  // of the ego
+  int ego_path_end_frame = -1;  // Motion::ego_path_end_frame
 };
 
 struct WriteOptions {

@@ -284,6 +284,11 @@ Motion simulateMotion(const Scenario& sc, const World& world) {
     }
   }
 
+  // Standing (under 0.1 m/s) from then on to the last frame, within 100 m of its path's end: at
+  // the end, or queued behind the traffic standing there.
+  const Mover& ego = movers[0];
+  for (int f = sc.frames - 1; f >= 0 && tr.v[0][f] < 0.1; --f)
+    if (ego.path->length() - tr.s[0][f] < 100.0) out.ego_path_end_frame = f;
   const BodyRide ride(sc.ego, streamKey({sc.seed, 10}));
   for (int f = 0; f < sc.frames; ++f) {
     const Path::Sample at = movers[0].path->at(tr.s[0][f]);

@@ -29,6 +29,11 @@ struct Motion {
   std::vector<Agent> agents;
   std::vector<Pose> ego;  // T_map_lidar per frame
   int removed = 0;        // objects dropped because their paths would overlap
+  // The frame from which the ego stands at the end of its path, or queued behind the traffic
+  // standing there, to the last frame (-1: never): a run longer than its
+  // scenario was written for. The world goes on (the ground is endless, the roadside and the
+  // traffic are still there), so its scans stay valid; the ego just stops moving.
+  int ego_path_end_frame = -1;
 };
 
 // The ego body's pitch, roll and heave on its suspension (EgoSpec), as a pose in the lidar frame

@@ -2,9 +2,9 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
-#include <chrono>
 #include <cmath>
 
+#include "dlslot/cpu_clock.hpp"
 #include "normal_equations.hpp"
 
 namespace dlslot::odometry {
@@ -78,21 +78,19 @@ Registration registerIteratively(const std::function<Matches(const Pose&)>& matc
                                  const SolverConfig& cfg, int min_correspondences) {
   Registration r;
   r.solution.T_ref_cur = guess;
-  using Clock = std::chrono::steady_clock;
-  auto ms = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
   for (int it = 0; it < cfg.outer_iterations; ++it) {
-    auto t = Clock::now();
+    double t = threadCpuMs();
     const Matches m = match(r.solution.T_ref_cur);
-    r.match_ms += ms(t);
+    r.match_ms += threadCpuMs() - t;
     r.num_correspondences = static_cast<int>(m.size());
     if (r.num_correspondences < min_correspondences) {
       r.solution.ok = false;
       break;
     }
     const Pose before = r.solution.T_ref_cur;
-    t = Clock::now();
+    t = threadCpuMs();
     r.solution = solvePose(m, before, cfg);
-    r.solve_ms += ms(t);
+    r.solve_ms += threadCpuMs() - t;
     if (!r.solution.ok) break;
     // Correspondences searched at a pose this close to the solution would be the same ones.
     const Pose step = before.inverse() * r.solution.T_ref_cur;

@@ -21,12 +21,13 @@ struct Rings {
   std::vector<int> start;  // ring b is columns [start[b], start[b+1])
 };
 
-Rings groupByBeam(const PointCloud& scan, const FeatureConfig& cfg) {
+Rings groupByBeam(const PointCloud& scan, const FeatureConfig& cfg, const std::vector<bool>* removed) {
   const BeamModel model(cfg);
   const float min_range2 = static_cast<float>(cfg.min_range_m * cfg.min_range_m);
   std::vector<int> beam(scan.cols(), -1);
   std::vector<int> count(model.numBeams() + 1, 0);
   for (Eigen::Index i = 0; i < scan.cols(); ++i) {
+    if (removed && (*removed)[i]) continue;
     const Eigen::Vector3f p = scan.col(i).head<3>();
     if (!p.allFinite() || p.squaredNorm() < min_range2) continue;
     beam[i] = model.beamOf(p);
@@ -184,8 +185,8 @@ class RingSelector {
 
 }  // namespace
 
-ScanFeatures extractFeatures(const PointCloud& scan, const FeatureConfig& cfg) {
-  const Rings rings = groupByBeam(scan, cfg);
+ScanFeatures extractFeatures(const PointCloud& scan, const FeatureConfig& cfg, const std::vector<bool>* removed) {
+  const Rings rings = groupByBeam(scan, cfg, removed);
   ScanFeatures out;
   out.num_points = static_cast<int>(rings.points.cols());
   for (size_t b = 0; b + 1 < rings.start.size(); ++b) {

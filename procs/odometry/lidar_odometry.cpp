@@ -94,18 +94,14 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
   // Features, after removing the points of potential dynamic objects (A-LOAM*, paper III-D).
   auto t = Clock::now();
   double cpu = threadCpuMs();
-  ScanFeatures features;
-  const PointCloud* scan = &frame.scan;
-  PointCloud kept;
+  std::vector<bool> inside;
   if (out.detections_used && !frame.detections.empty()) {
-    const std::vector<bool> inside = pointsInBoxes(*scan, frame.detections, cfg_.box_margin_m);
+    inside = pointsInBoxes(frame.scan, frame.detections, cfg_.box_margin_m);
     for (bool in : inside) out.num_points_removed += in ? 1 : 0;
-    kept = keepOutside(*scan, inside);
-    scan = &kept;
   }
   out.detail.emplace_back("box_removal", threadCpuMs() - cpu);
   cpu = threadCpuMs();
-  features = extractFeatures(*scan, cfg_.features);
+  ScanFeatures features = extractFeatures(frame.scan, cfg_.features, inside.empty() ? nullptr : &inside);
   out.detail.emplace_back("feature_extraction", threadCpuMs() - cpu);
   out.num_edge = static_cast<int>(features.sharp.size());
   out.num_plane = static_cast<int>(features.flat.size());

@@ -179,7 +179,7 @@ class RingSelector {
   const FeatureConfig& cfg_;
   Eigen::VectorXf curvature_;
   std::vector<int8_t> label_;
-  std::vector<bool> picked_;
+  std::vector<uint8_t> picked_;  // not std::vector<bool>: its bit access cost 1.5 % of the odometry
   std::vector<Candidate> edge_candidates_, flat_candidates_;
 };
 

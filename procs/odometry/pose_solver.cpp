@@ -45,7 +45,7 @@ PoseSolution solvePose(const Matches& matches, const Pose& guess, const SolverCo
   // after a rejected one. Every try counts as one of cfg.solver_iterations.
   const Matches local = expressedIn(matches, guess);
   Vector6d x = Vector6d::Zero();
-  NormalEquations ne = linearize(local, x.data(), cfg.huber_delta_m);
+  NormalEquations ne = linearize(local, x.data(), cfg.huber_delta_m, false);
   if (!std::isfinite(ne.cost)) return sol;
   double lambda = 1e-4;
   for (int it = 0; it < cfg.solver_iterations; ++it) {
@@ -54,7 +54,7 @@ PoseSolution solvePose(const Matches& matches, const Pose& guess, const SolverCo
     const Vector6d dx = A.ldlt().solve(-ne.g);
     if (!dx.allFinite()) break;
     const Vector6d x_new = x + dx;
-    NormalEquations next = linearize(local, x_new.data(), cfg.huber_delta_m);
+    NormalEquations next = linearize(local, x_new.data(), cfg.huber_delta_m, false);
     if (std::isfinite(next.cost) && next.cost < ne.cost) {
       const double decrease = (ne.cost - next.cost) / std::max(ne.cost, 1e-300);
       x = x_new;

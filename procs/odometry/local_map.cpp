@@ -151,32 +151,39 @@ void VoxelLayer::nearest(const Eigen::Vector3f& q, int k, Neighbours& out) const
       const double g = v < lo ? lo - v : (v > lo + block_ ? v - lo - block_ : 0.0);
       gap2[a][c - first[a]] = static_cast<float>(g * g);
     }
+  // The k best so far, sorted, in the output's own storage (no push_back per candidate);
+  // `worst` is the distance a candidate must beat: the radius until k are found, then the k-th.
+  out.d2.resize(k);
+  out.points.resize(k);
+  float* best_d2 = out.d2.data();
+  Eigen::Vector3f* best = out.points.data();
+  int n = 0;
+  float worst = radius2_;
   for (int64_t bz = z0; bz <= z1; ++bz)
     for (int64_t by = y0; by <= y1; ++by)
       for (int64_t bx = x0; bx <= x1; ++bx) {
         const float box2 = gap2[0][bx - x0] + gap2[1][by - y0] + gap2[2][bz - z0];
-        if (box2 >= radius2_ || (out.size() == k && box2 >= out.d2.back())) continue;
+        if (box2 >= worst) continue;
         const int b = index_.find(blockKey(bx, by, bz));
         if (b == BlockIndex::kMissing) continue;
-        const size_t base = static_cast<size_t>(b) * capacity_;
-        for (int i = 0; i < blocks_[b].n; ++i) {
-          const Eigen::Vector3f& p = means_[base + i];
-          const float d2 = (p - q).squaredNorm();
-          if (d2 >= radius2_ || (out.size() == k && d2 >= out.d2.back())) continue;
-          // Insertion into the sorted k best.
-          if (out.size() < k) {
-            out.d2.push_back(d2);
-            out.points.push_back(p);
+        const Eigen::Vector3f* p = means_.data() + static_cast<size_t>(b) * capacity_;
+        const Eigen::Vector3f* end = p + blocks_[b].n;
+        for (; p != end; ++p) {
+          const float d2 = (*p - q).squaredNorm();
+          if (d2 >= worst) continue;
+          // Insertion into the sorted k best (the last one drops out when they are k).
+          int j = n < k ? n++ : k - 1;
+          for (; j > 0 && best_d2[j - 1] > d2; --j) {
+            best_d2[j] = best_d2[j - 1];
+            best[j] = best[j - 1];
           }
-          int j = out.size() - 1;
-          for (; j > 0 && out.d2[j - 1] > d2; --j) {
-            out.d2[j] = out.d2[j - 1];
-            out.points[j] = out.points[j - 1];
-          }
-          out.d2[j] = d2;
-          out.points[j] = p;
+          best_d2[j] = d2;
+          best[j] = *p;
+          if (n == k) worst = best_d2[k - 1];
         }
       }
+  out.d2.resize(n);
+  out.points.resize(n);
 }
 
 std::vector<Eigen::Vector3f> VoxelLayer::points() const {

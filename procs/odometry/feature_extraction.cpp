@@ -165,11 +165,13 @@ class RingSelector {
     const float cos_gap = static_cast<float>(std::cos(cfg_.max_azimuth_gap_deg * M_PI / 180.0));
     int last_gap = -n;  // index i of the last gap between points i and i+1
     std::vector<int> gap_before(n);  // the last gap at or before point i (between j and j+1, j < i)
+    float norm_next = n > 0 ? ring_.col(0).head<2>().norm() : 0.0f;  // each norm computed once
     for (int i = 0; i < n; ++i) {
       gap_before[i] = last_gap;
       if (i + 1 < n) {
-        const Eigen::Vector2f a = ring_.col(i).head<2>(), b = ring_.col(i + 1).head<2>();
-        if (a.dot(b) < cos_gap * a.norm() * b.norm()) last_gap = i;
+        const float norm_i = norm_next;
+        norm_next = ring_.col(i + 1).head<2>().norm();
+        if (ring_.col(i).head<2>().dot(ring_.col(i + 1).head<2>()) < cos_gap * norm_i * norm_next) last_gap = i;
       }
     }
     // Point i's window [i-w, i+w] spans a gap when one lies between i-w and i+w-1.

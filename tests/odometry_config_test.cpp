@@ -19,9 +19,12 @@ TEST(OdometryConfig, ShippedSectionIsCompleteAndMatchesTheDefaults) {
   const OdometryConfig d;
   EXPECT_EQ(c.remove_detected_objects, d.remove_detected_objects);
   EXPECT_EQ(c.features.beam_model, d.features.beam_model);
+  EXPECT_EQ(c.scan_to_scan.every_scan, d.scan_to_scan.every_scan);
   EXPECT_EQ(c.features.less_sharp_per_sector, d.features.less_sharp_per_sector);
   EXPECT_DOUBLE_EQ(c.scan_to_map.plane_voxel_m, d.scan_to_map.plane_voxel_m);
   EXPECT_EQ(c.scan_to_map.solver.outer_iterations, d.scan_to_map.solver.outer_iterations);
+  EXPECT_DOUBLE_EQ(c.scan_to_map.solver.converged_step_m, d.scan_to_map.solver.converged_step_m);
+  EXPECT_DOUBLE_EQ(c.scan_to_map.solver.converged_step_deg, d.scan_to_map.solver.converged_step_deg);
 }
 
 std::string withReplaced(const std::string& from, const std::string& to) {

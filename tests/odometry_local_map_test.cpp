@@ -1,7 +1,9 @@
 // The incrementally updated local map (local_map.hpp, block_index.hpp): nearest-neighbour
 // queries against a brute-force search over the same voxel means, cropping against a
-// brute-force filter, the running mean per voxel, and the block hash against std::unordered_map.
+// brute-force filter, the running mean per voxel, the block hash against std::unordered_map, and
+// the scan's voxel downsampling against PCL's VoxelGrid filter.
 #include <gtest/gtest.h>
+#include <pcl/filters/voxel_grid.h>
 
 #include <algorithm>
 #include <random>
@@ -124,6 +126,31 @@ TEST(OdometryBlockIndex, AgreesWithAnUnorderedMap) {
     const auto it = reference.find(k);
     EXPECT_EQ(index.find(k), it == reference.end() ? BlockIndex::kMissing : it->second) << "key " << k;
   }
+}
+
+// The same voxels, in the same order, with the same centroids (to float rounding: the sums may
+// run in another order) as PCL's VoxelGrid, which it replaces; no NaN passes.
+TEST(OdometryDownsample, EqualsPclVoxelGrid) {
+  std::mt19937 rng(7);
+  FeatureCloud cloud = test::randomFlatCloud(20000, 40.0f, 0.1f, rng);
+  cloud[5].x = std::numeric_limits<float>::quiet_NaN();
+  cloud.is_dense = false;  // PCL checks for NaN only then
+  for (const double voxel : {0.4, 0.8}) {
+    FeatureCloud expected;
+    pcl::VoxelGrid<pcl::PointXYZI> grid;
+    const float v = static_cast<float>(voxel);
+    grid.setLeafSize(v, v, v);
+    grid.setInputCloud(FeatureCloud::ConstPtr(&cloud, [](const FeatureCloud*) {}));
+    grid.filter(expected);
+    const FeatureCloud got = downsample(cloud, voxel);
+    ASSERT_EQ(got.size(), expected.size()) << voxel;
+    ASSERT_LT(got.size(), cloud.size());
+    for (size_t i = 0; i < got.size(); ++i) {
+      ASSERT_LT((got[i].getVector3fMap() - expected[i].getVector3fMap()).norm(), 1e-4f) << voxel << " point " << i;
+      ASSERT_NEAR(got[i].intensity, expected[i].intensity, 1e-3f);
+    }
+  }
+  EXPECT_TRUE(downsample(FeatureCloud(), 0.4).empty());
 }
 
 }  // namespace

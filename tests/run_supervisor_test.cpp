@@ -51,3 +51,19 @@ TEST(RunSupervisor, StoppedChildIsNotReported) {
   EXPECT_FALSE(sup.reap());
   fs::remove(logPath("sleeper"));
 }
+
+// The CPU time a child used is known once it has exited: a busy child (copying 2 GB through dd)
+// used far more than one that slept as long.
+TEST(RunSupervisor, CpuTimeOfExitedChildren) {
+  Supervisor sup;
+  sup.start("busy", {"/bin/dd", "if=/dev/zero", "of=/dev/null", "bs=1M", "count=2000"}, logPath("busy"));
+  sup.start("sleeper", {"/bin/sleep", "0.3"}, logPath("sleeper"));
+  EXPECT_LT(sup.cpuSeconds("busy"), 0.0);  // still running
+  waitUntilExited(sup, "busy");
+  waitUntilExited(sup, "sleeper");
+  EXPECT_GT(sup.cpuSeconds("busy"), 0.05);
+  EXPECT_GE(sup.cpuSeconds("sleeper"), 0.0);
+  EXPECT_LT(sup.cpuSeconds("sleeper"), 0.05);
+  fs::remove(logPath("busy"));
+  fs::remove(logPath("sleeper"));
+}

@@ -61,11 +61,10 @@ class BlockIndex {
  private:
   static constexpr int64_t kEmpty = INT64_MIN;
   size_t home(int64_t key) const {
-    // splitmix64's finalizer: neighbouring blocks land far apart.
-    uint64_t z = static_cast<uint64_t>(key) + 0x9e3779b97f4a7c15ULL;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return static_cast<size_t>(z ^ (z >> 31)) & mask_;
+    // Fibonacci hashing: the top bits of key times 2^64 / golden ratio. One multiply (the
+    // splitmix64 finalizer it replaces took three and cost 1 % of the odometry); neighbouring
+    // blocks still land far apart.
+    return static_cast<size_t>((static_cast<uint64_t>(key) * 0x9e3779b97f4a7c15ULL) >> shift_);
   }
   void grow() {
     std::vector<int64_t> old_keys = std::move(keys_);
@@ -74,6 +73,8 @@ class BlockIndex {
     keys_.assign(cap, kEmpty);
     values_.assign(cap, kMissing);
     mask_ = cap - 1;
+    shift_ = 64;
+    for (size_t c = cap; c > 1; c >>= 1) --shift_;
     size_ = 0;
     for (size_t i = 0; i < old_keys.size(); ++i)
       if (old_keys[i] != kEmpty) set(old_keys[i], old_values[i]);
@@ -82,6 +83,7 @@ class BlockIndex {
   std::vector<int64_t> keys_;
   std::vector<int> values_;
   size_t size_ = 0, mask_ = 0;
+  int shift_ = 63;  // 64 - log2(capacity)
 };
 
 }  // namespace dlslot::odometry

@@ -2,7 +2,7 @@
 
 namespace dlslot::odometry {
 
-Eigen::VectorXf ringCurvature(const Eigen::Matrix3Xf& ring, int half_window) {
+Eigen::VectorXf ringCurvature(const Eigen::Ref<const Eigen::Matrix3Xf>& ring, int half_window) {
   const Eigen::Index n = ring.cols(), w = half_window;
   Eigen::VectorXf c = Eigen::VectorXf::Constant(n, -1.0f);
   if (n < 2 * w + 1) return c;

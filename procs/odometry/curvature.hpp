@@ -8,6 +8,6 @@ namespace dlslot::odometry {
 
 // Curvature of every point of one ring (points in firing order); the first and last
 // `half_window` points have no full window and get -1.
-Eigen::VectorXf ringCurvature(const Eigen::Matrix3Xf& ring, int half_window);
+Eigen::VectorXf ringCurvature(const Eigen::Ref<const Eigen::Matrix3Xf>& ring, int half_window);
 
 }  // namespace dlslot::odometry

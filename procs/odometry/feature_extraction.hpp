@@ -23,6 +23,9 @@ struct ScanFeatures {
   int num_points = 0;       // points that passed the range and beam checks
 };
 
-ScanFeatures extractFeatures(const PointCloud& scan, const FeatureConfig& cfg);
+// `removed` (when given, one flag per scan point): points left out, as if not in the scan (the
+// detected objects of A-LOAM*, without copying the rest of the scan).
+ScanFeatures extractFeatures(const PointCloud& scan, const FeatureConfig& cfg,
+                             const std::vector<bool>* removed = nullptr);
 
 }  // namespace dlslot::odometry

@@ -34,9 +34,10 @@ struct OdometryResult {
   int num_correspondences = 0;                // scan-to-map, last search
   double residual_mean = 0.0;                 // scan-to-map inliers, m
   StageTimings timings;                       // features, scan_to_scan, scan_to_map, total (ms)
-  // Inside those stages (ms): box_removal, feature_extraction, s2s_match, s2s_solve,
-  // s2m_downsample, s2m_match, s2m_solve, map_update, s2s_index (the index of this scan for the
-  // next scan-to-scan: in "total" only). For benchmarks; not published.
+  // Inside those stages, CPU ms of the calling thread: box_removal, feature_extraction,
+  // s2s_index (the previous scan's grids, built when scan-to-scan runs), s2s_match, s2s_solve,
+  // s2m_downsample, s2m_match, s2m_solve, map_update, s2s_reference (keeping this scan for the
+  // next). For benchmarks; not published.
   StageTimings detail;
 };
 
@@ -63,11 +64,12 @@ class LidarOdometry {
   ScanReference reference_;                    // the last registered scan's features
   Pose T_world_reference_ = Pose::Identity();  // ...and its pose
   Pose T_world_last_ = Pose::Identity();       // the last published pose
-  Pose velocity_ = Pose::Identity();           // the last delta: constant-velocity model
+  Pose velocity_ = Pose::Identity();           // motion per frame: constant-velocity model
   bool started_ = false;
   bool moving_ = false;                        // velocity_ comes from a registration
   int fallbacks_ = 0;                          // consecutive fallback frames (fallback_motion.hpp)
   Pose registered_velocity_ = Pose::Identity();  // velocity_ at the last registration (never decayed)
+  int last_index_ = 0;                         // frame index of the last scan
 };
 
 }  // namespace dlslot::odometry

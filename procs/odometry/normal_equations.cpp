@@ -26,11 +26,14 @@ namespace {
 // (rho'' <= 0), so this is the same iteratively reweighted problem.
 struct Huber {
   double delta, delta2;
+  bool statistics;
   void add(double s, NormalEquations& ne, double& w) const {
     if (s <= delta2) {
       ne.cost += 0.5 * s;
-      ne.sum_abs_inliers += std::sqrt(s);
-      ++ne.num_inliers;
+      if (statistics) {
+        ne.sum_abs_inliers += std::sqrt(s);
+        ++ne.num_inliers;
+      }
       w = 1.0;
     } else {
       const double r = std::sqrt(s);
@@ -42,14 +45,14 @@ struct Huber {
 
 }  // namespace
 
-NormalEquations linearize(const Matches& matches, const double* x, double huber_delta) {
+NormalEquations linearize(const Matches& matches, const double* x, double huber_delta, bool inlier_statistics) {
   NormalEquations ne;
   RigidMotion motion;
   motion.at(x);
   const Eigen::Matrix3d& R = motion.rotation();
   const Eigen::Vector3d& t = motion.translation();
   const Eigen::Matrix3d& Jl = motion.leftJacobian();
-  const Huber huber{huber_delta, huber_delta * huber_delta};
+  const Huber huber{huber_delta, huber_delta * huber_delta, inlier_statistics};
   // The Jacobian of T(x) p is [I, -[Rp]x Jl] (rigid_motion.hpp). Written per block rather than
   // as J^T J of the 3x6 / 1x6 Jacobians (edgeResidual / planeResidual, which the tests compare
   // with numeric differences): this pass runs ~6 times per solve over every correspondence.
@@ -72,21 +75,26 @@ NormalEquations linearize(const Matches& matches, const double* x, double huber_
     gt += w * r;
     gw.noalias() -= w * (C.transpose() * r);
   }
+  // Planes: J = [n^T, ((Rp) x n)^T Jl], a 1x6 row; only the upper triangle of w J^T J is summed.
+  Matrix6d Hp = Matrix6d::Zero();
+  Vector6d gp = Vector6d::Zero();
   for (const PlaneMatch& m : matches.planes) {
-    // r = n . q + d; J = [n^T, ((Rp) x n)^T Jl].
     const Eigen::Vector3d Rp = R * m.p;
     const double r = m.n.dot(Rp + t) + m.d;
     double w;
     huber.add(r * r, ne, w);
-    const Eigen::Vector3d jw = Jl.transpose() * Rp.cross(m.n);
-    Htt.noalias() += (w * m.n) * m.n.transpose();
-    Htw.noalias() += (w * m.n) * jw.transpose();
-    Hww.noalias() += (w * jw) * jw.transpose();
-    gt += (w * r) * m.n;
-    gw += (w * r) * jw;
+    Vector6d J;
+    J << m.n, Jl.transpose() * Rp.cross(m.n);
+    const Vector6d wJ = w * J;
+    for (int j = 0; j < 6; ++j)
+      for (int i = 0; i <= j; ++i) Hp(i, j) += wJ[i] * J[j];
+    gp += r * wJ;
   }
+  Hp.triangularView<Eigen::StrictlyLower>() = Hp.transpose();
   ne.H << Htt, Htw, Htw.transpose(), Hww;
+  ne.H += Hp;
   ne.g << gt, gw;
+  ne.g += gp;
   return ne;
 }
 

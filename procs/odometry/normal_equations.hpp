@@ -20,12 +20,14 @@ struct NormalEquations {
   Matrix6d H = Matrix6d::Zero();   // sum(rho' J^T J)
   Vector6d g = Vector6d::Zero();   // sum(rho' J^T r)
   double cost = 0.0;               // 1/2 sum(rho(|r|^2)), Ceres' convention
-  int num_inliers = 0;             // |r| <= huber delta
-  double sum_abs_inliers = 0.0;    // sum |r| over the inliers
+  int num_inliers = 0;             // |r| <= huber delta (with inlier_statistics)
+  double sum_abs_inliers = 0.0;    // sum |r| over the inliers (with inlier_statistics)
 };
 
 // Linearizes all matches at x (matches in the reference frame of the parameterization).
-NormalEquations linearize(const Matches& matches, const double* x, double huber_delta);
+// inlier_statistics false: num_inliers and sum_abs_inliers are left at 0 (no square root per
+// inlier; the solve's own steps need only H, g and the cost).
+NormalEquations linearize(const Matches& matches, const double* x, double huber_delta, bool inlier_statistics = true);
 
 // One residual and its 1x6 / 3x6 Jacobian at x, for tests.
 double planeResidual(const PlaneMatch& m, const RigidMotion& motion, Eigen::Matrix<double, 1, 6>* J);

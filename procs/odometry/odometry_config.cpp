@@ -51,6 +51,7 @@ void readFeatures(ConfigSection s, FeatureConfig& c) {
 }
 
 void readScanToScan(ConfigSection s, ScanToScanConfig& c) {
+  s.get("every_scan", c.every_scan);
   readSolver(s.section("solver"), c.solver);
   s.get("max_match_distance_m", c.max_match_distance_m);
   s.get("nearby_beams", c.nearby_beams);

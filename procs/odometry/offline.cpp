@@ -39,6 +39,7 @@ int runOffline(const OfflineOptions& opts, const OdometryConfig& cfg) {
   std::map<std::string, TimingStats> stages;
   std::map<Status, int> statuses;
   long removed = 0, points = 0;
+  int scan_to_scan_runs = 0;  // scans that needed scan-to-scan (every_scan false: few)
   // Per-scan statistics of registered scans, to compare simulated scans with real ones (issue 15).
   TimingStats edges, planes, residuals, correspondences;
   ProgressLine progress("odometry " + opts.sequence + " (" + modeName(cfg.remove_detected_objects) + ")",
@@ -57,6 +58,8 @@ int runOffline(const OfflineOptions& opts, const OdometryConfig& cfg) {
       correspondences.add(r.num_correspondences);
     }
     points += r.num_points_in;
+    for (const auto& [name, ms] : r.detail)
+      if (name == "s2s_match" && ms > 0) ++scan_to_scan_runs;
     for (const auto& [name, ms] : r.timings) {
       if (!stages.count(name)) stage_order.push_back(name);
       stages[name].add(ms);
@@ -70,6 +73,7 @@ int runOffline(const OfflineOptions& opts, const OdometryConfig& cfg) {
   std::printf("mode %s: %.2f %% of the points removed as detected objects\n", modeName(cfg.remove_detected_objects),
               points > 0 ? 100.0 * removed / points : 0.0);
   for (const auto& [status, n] : statuses) std::printf("  %-26s %d frames\n", statusName(status), n);
+  std::printf("scan-to-scan registration on %d of %d frames\n", scan_to_scan_runs, reader.size());
   std::printf("%-14s %9s %9s %9s   (ms per frame)\n", "stage", "mean", "p95", "max");
   for (const std::string& name : stage_order)
     std::printf("%-14s %9.2f %9.2f %9.2f\n", name.c_str(), stages[name].mean(), stages[name].percentile(95),

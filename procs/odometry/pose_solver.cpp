@@ -2,9 +2,9 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
-#include <chrono>
 #include <cmath>
 
+#include "dlslot/cpu_clock.hpp"
 #include "normal_equations.hpp"
 
 namespace dlslot::odometry {
@@ -45,7 +45,7 @@ PoseSolution solvePose(const Matches& matches, const Pose& guess, const SolverCo
   // after a rejected one. Every try counts as one of cfg.solver_iterations.
   const Matches local = expressedIn(matches, guess);
   Vector6d x = Vector6d::Zero();
-  NormalEquations ne = linearize(local, x.data(), cfg.huber_delta_m);
+  NormalEquations ne = linearize(local, x.data(), cfg.huber_delta_m, false);
   if (!std::isfinite(ne.cost)) return sol;
   double lambda = 1e-4;
   for (int it = 0; it < cfg.solver_iterations; ++it) {
@@ -54,7 +54,7 @@ PoseSolution solvePose(const Matches& matches, const Pose& guess, const SolverCo
     const Vector6d dx = A.ldlt().solve(-ne.g);
     if (!dx.allFinite()) break;
     const Vector6d x_new = x + dx;
-    NormalEquations next = linearize(local, x_new.data(), cfg.huber_delta_m);
+    NormalEquations next = linearize(local, x_new.data(), cfg.huber_delta_m, false);
     if (std::isfinite(next.cost) && next.cost < ne.cost) {
       const double decrease = (ne.cost - next.cost) / std::max(ne.cost, 1e-300);
       x = x_new;
@@ -78,21 +78,19 @@ Registration registerIteratively(const std::function<Matches(const Pose&)>& matc
                                  const SolverConfig& cfg, int min_correspondences) {
   Registration r;
   r.solution.T_ref_cur = guess;
-  using Clock = std::chrono::steady_clock;
-  auto ms = [](Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); };
   for (int it = 0; it < cfg.outer_iterations; ++it) {
-    auto t = Clock::now();
+    double t = threadCpuMs();
     const Matches m = match(r.solution.T_ref_cur);
-    r.match_ms += ms(t);
+    r.match_ms += threadCpuMs() - t;
     r.num_correspondences = static_cast<int>(m.size());
     if (r.num_correspondences < min_correspondences) {
       r.solution.ok = false;
       break;
     }
     const Pose before = r.solution.T_ref_cur;
-    t = Clock::now();
+    t = threadCpuMs();
     r.solution = solvePose(m, before, cfg);
-    r.solve_ms += ms(t);
+    r.solve_ms += threadCpuMs() - t;
     if (!r.solution.ok) break;
     // Correspondences searched at a pose this close to the solution would be the same ones.
     const Pose step = before.inverse() * r.solution.T_ref_cur;

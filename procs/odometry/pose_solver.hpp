@@ -55,7 +55,7 @@ void measureConstraint(const Matches& matches, double huber_delta, PoseSolution&
 struct Registration {
   PoseSolution solution;
   int num_correspondences = 0;  // of the last correspondence search
-  double match_ms = 0.0;        // wall time in correspondence searches
+  double match_ms = 0.0;        // CPU time of this thread in correspondence searches
   double solve_ms = 0.0;        // ...and in solves
 };
 

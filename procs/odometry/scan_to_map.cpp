@@ -1,18 +1,28 @@
 #include "scan_to_map.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
 
 namespace dlslot::odometry {
 
 namespace {
 
-// The k nearest map points of q as columns of `out`, or false when there are not k within the
-// search radius (cfg.max_neighbor_distance_m, the map's).
-bool neighbours(const VoxelLayer& layer, const Eigen::Vector3f& q, int k, Neighbours& nb, Eigen::Matrix3Xd& out) {
-  layer.nearest(q, k, nb);
-  if (nb.size() < k) return false;
-  out.resize(3, k);
-  for (int j = 0; j < k; ++j) out.col(j) = nb.points[j].cast<double>();
+// The k nearest map points of q (found.points), their mean and scatter matrix, or false when
+// there are not k within the search radius (cfg.max_neighbor_distance_m, the map's). In double
+// as A-LOAM fits them; no allocation per query (this runs ~10^4 times a search).
+bool fitNeighbours(const VoxelLayer& layer, const Eigen::Vector3f& q, int k, Neighbours& found, Eigen::Vector3d& mean,
+                   Eigen::Matrix3d& scatter) {
+  layer.nearest(q, k, found);
+  if (found.size() < k) return false;
+  mean.setZero();
+  for (int j = 0; j < k; ++j) mean += found.points[j].cast<double>();
+  mean /= k;
+  scatter.setZero();
+  for (int j = 0; j < k; ++j) {
+    const Eigen::Vector3d d = found.points[j].cast<double>() - mean;
+    scatter.noalias() += d * d.transpose();
+  }
   return true;
 }
 
@@ -24,18 +34,17 @@ Matches matchScanToMap(const FeatureCloud& edges, const FeatureCloud& planes, co
   m.edges.reserve(edges.size());
   m.planes.reserve(planes.size());
   const Eigen::Isometry3f T = T_world_lidar.cast<float>();
-  Eigen::Matrix3Xd nb;
   Neighbours found;
+  Eigen::Vector3d mean;
+  Eigen::Matrix3d scatter;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
 
   // An edge point matches the line through its neighbours when they are spread along one
   // direction (largest covariance eigenvalue dominates the second).
   for (const auto& pt : edges) {
     const Eigen::Vector3f p = pt.getVector3fMap();
-    if (!neighbours(map.edges(), T * p, cfg.neighbors, found, nb)) continue;
-    const Eigen::Vector3d mean = nb.rowwise().mean();
-    const Eigen::Matrix3Xd centred = nb.colwise() - mean;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-    eig.computeDirect(centred * centred.transpose());
+    if (!fitNeighbours(map.edges(), T * p, cfg.neighbors, found, mean, scatter)) continue;
+    eig.computeDirect(scatter);
     if (eig.eigenvalues()[2] <= cfg.edge_eigen_ratio * eig.eigenvalues()[1]) continue;
     m.edges.push_back({p.cast<double>(), mean, eig.eigenvectors().col(2)});
   }
@@ -43,13 +52,13 @@ Matches matchScanToMap(const FeatureCloud& edges, const FeatureCloud& planes, co
   // A plane point matches the plane fitted to its neighbours when every neighbour lies on it.
   for (const auto& pt : planes) {
     const Eigen::Vector3f p = pt.getVector3fMap();
-    if (!neighbours(map.planes(), T * p, cfg.neighbors, found, nb)) continue;
-    const Eigen::Vector3d mean = nb.rowwise().mean();
-    const Eigen::Matrix3Xd centred = nb.colwise() - mean;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-    eig.computeDirect(centred * centred.transpose());
+    if (!fitNeighbours(map.planes(), T * p, cfg.neighbors, found, mean, scatter)) continue;
+    eig.computeDirect(scatter);
     const Eigen::Vector3d n = eig.eigenvectors().col(0);
-    if ((n.transpose() * centred).cwiseAbs().maxCoeff() > cfg.plane_max_deviation_m) continue;
+    double deviation = 0.0;
+    for (int j = 0; j < cfg.neighbors; ++j)
+      deviation = std::max(deviation, std::abs(n.dot(found.points[j].cast<double>() - mean)));
+    if (deviation > cfg.plane_max_deviation_m) continue;
     m.planes.push_back({p.cast<double>(), n, -n.dot(mean)});
   }
   return m;

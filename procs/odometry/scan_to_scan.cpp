@@ -1,14 +1,21 @@
 #include "scan_to_scan.hpp"
 
 #include <cmath>
+#include <utility>
 
 namespace dlslot::odometry {
 
-void ScanReference::reset(const ScanFeatures& f) {
-  edges_ = f.less_sharp;
-  planes_ = f.less_flat;
+void ScanReference::reset(ScanFeatures f) {
+  edges_ = std::move(f.less_sharp);
+  planes_ = std::move(f.less_flat);
+  indexed_ = false;
+}
+
+void ScanReference::index() {
+  if (indexed_) return;
   edge_grid_.build(edges_);
   plane_grid_.build(planes_);
+  indexed_ = true;
 }
 
 namespace {
@@ -83,14 +90,14 @@ Matches matchScanToScan(const ScanFeatures& current, const ScanReference& previo
   return m;
 }
 
-Registration registerScanToScan(const ScanFeatures& current, const ScanReference& previous,
-                                    const Pose& guess, const ScanToScanConfig& cfg) {
+Registration registerScanToScan(const ScanFeatures& current, ScanReference& previous, const Pose& guess,
+                                const ScanToScanConfig& cfg) {
+  previous.index();
   return registerIteratively([&](const Pose& T) { return matchScanToScan(current, previous, T, cfg); }, guess, cfg.solver,
                              cfg.min_correspondences);
 }
 
-Registration registerFirstMotion(const ScanFeatures& current, const ScanReference& previous,
-                                 const ScanToScanConfig& cfg) {
+Registration registerFirstMotion(const ScanFeatures& current, ScanReference& previous, const ScanToScanConfig& cfg) {
   Registration best;
   for (double forward : cfg.first_motion_guesses_m) {
     Pose guess = Pose::Identity();

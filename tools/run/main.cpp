@@ -294,6 +294,19 @@ int runPipeline(int argc, char** argv) {
   }
   node.spinUntil([] { return false; }, 0.3);
   sup.stop("lcm-logger");
+  // Where the two cores went: each process's CPU time over the whole run, per played frame.
+  {
+    std::string line;
+    for (const std::string p : {"odometry", "tracker", "backend", "renderer", "player", "lcm-logger"}) {
+      if (p == std::string("renderer") && no_render) continue;
+      const double s = sup.cpuSeconds(p);
+      if (s < 0) continue;
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%s%s %.1f ms", line.empty() ? "" : ", ", p.c_str(), 1e3 * s / (last_frame + 1));
+      line += buf;
+    }
+    std::fprintf(stderr, "CPU per frame: %s\n", line.c_str());
+  }
   // The pipeline rate: from the player's start (less its start-up delay) to the last SLOT_STATE.
   const double play_s = std::chrono::duration<double>(last_slot_time - play_start).count() - 0.2;
   std::fprintf(stderr, "SLOT_STATE for %d of %d frames; pipeline rate %.2f frames/s (%s)\n", slot_frames,

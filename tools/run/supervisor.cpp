@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,6 +15,15 @@
 #include <thread>
 
 namespace dlslot::run {
+
+namespace {
+
+double seconds(const rusage& u) {
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+}  // namespace
 
 Supervisor::~Supervisor() { stopAll(2.0); }
 
@@ -54,9 +64,11 @@ std::string Supervisor::describe(int code) {
 bool Supervisor::poll(Child& c) {
   if (c.done) return true;
   int status = 0;
-  if (waitpid(c.pid, &status, WNOHANG) == c.pid) {
+  rusage usage{};
+  if (wait4(c.pid, &status, WNOHANG, &usage) == c.pid) {
     c.done = true;
     c.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    c.cpu_s = seconds(usage);
   }
   return c.done;
 }
@@ -87,9 +99,11 @@ int Supervisor::stop(const std::string& name, double grace_s, const std::functio
   if (running(name)) {
     kill(c.pid, SIGKILL);
     int status = 0;
-    waitpid(c.pid, &status, 0);
+    rusage usage{};
+    wait4(c.pid, &status, 0, &usage);
     c.done = true;
     c.code = 128 + SIGKILL;
+    c.cpu_s = seconds(usage);
   }
   return c.code;
 }
@@ -110,6 +124,8 @@ std::string Supervisor::tail(const std::string& name, int n) const {
   for (const auto& l : lines) out += "    " + l + "\n";
   return out;
 }
+
+double Supervisor::cpuSeconds(const std::string& name) const { return find(name).cpu_s; }
 
 const std::string& Supervisor::logPath(const std::string& name) const { return find(name).log; }
 

@@ -37,6 +37,9 @@ class Supervisor {
   // Stops every running child, newest first.
   void stopAll(double grace_s = 5.0);
 
+  // CPU seconds (user + system) a child used, known once it has exited (else -1).
+  double cpuSeconds(const std::string& name) const;
+
   // The last n lines of a child's log.
   std::string tail(const std::string& name, int n = 15) const;
   const std::string& logPath(const std::string& name) const;
@@ -48,6 +51,7 @@ class Supervisor {
     bool done = false;      // exited (or stopped)
     bool reported = false;  // by reap(), or stopped on purpose
     int code = 0;
+    double cpu_s = -1.0;    // user + system, from wait4 at exit
   };
   // Notes the exit of c if it has exited; true when it has.
   static bool poll(Child& c);

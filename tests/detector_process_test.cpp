@@ -13,6 +13,7 @@
 #include "dlslot/detections_t.hpp"
 #include "dlslot/point_cloud_t.hpp"
 #include "dlslot/process_status_t.hpp"
+#include "dlslot/frame_accounting.hpp"
 #include "process_harness.hpp"
 
 using namespace dlslot;
@@ -31,12 +32,6 @@ struct Listener {
     has_status = true;
   }
 };
-
-int64_t counter(const process_status_t& s, const std::string& name) {
-  for (int i = 0; i < s.num_counters; ++i)
-    if (s.counter_names[i] == name) return s.counter_values[i];
-  return 0;
-}
 
 point_cloud_t scanMessage(int frame, const PointCloud& cloud) {
   point_cloud_t m;
@@ -115,8 +110,8 @@ TEST(DetectorProcess, ScansInDetectionsOutFaultsCounted) {
   EXPECT_EQ(s.frames_handled, 3);
   EXPECT_GE(s.decode_errors, 1);  // the garbage
   EXPECT_GE(s.errors + s.decode_errors, 2);  // and the NaN scan, refused as a whole
-  EXPECT_EQ(counter(s, "boxes_Car"), 2);
-  EXPECT_EQ(counter(s, "boxes_Pedestrian"), 2);
+  EXPECT_EQ(statusCounter(s, "boxes_Car"), 2);
+  EXPECT_EQ(statusCounter(s, "boxes_Pedestrian"), 2);
 }
 
 TEST(DetectorProcess, BadConfigIsRefused) {

@@ -16,6 +16,7 @@
 #include "dlslot/point_cloud_t.hpp"
 #include "dlslot/process_status_t.hpp"
 #include "odometry_scene.hpp"
+#include "dlslot/frame_accounting.hpp"
 #include "process_harness.hpp"
 
 using namespace dlslot;
@@ -34,12 +35,6 @@ struct Listener {
     has_status = true;
   }
 };
-
-int64_t counter(const process_status_t& s, const std::string& name) {
-  for (int i = 0; i < s.num_counters; ++i)
-    if (s.counter_names[i] == name) return s.counter_values[i];
-  return 0;
-}
 
 std::string configWithTimeout(const std::string& dir, double timeout_s) {
   std::ifstream in(config());
@@ -170,7 +165,7 @@ TEST(OdometryProcess, FaultsDoNotStopIt) {
   EXPECT_GE(s.decode_errors, 1);
   EXPECT_GE(s.errors, 1);
   EXPECT_GE(s.timeouts, 1);
-  EXPECT_EQ(counter(s, "unfiltered_frames"), 1);
-  EXPECT_EQ(counter(s, "fallback_frames"), 1);
-  EXPECT_EQ(counter(s, "rejected_detections"), 1);
+  EXPECT_EQ(statusCounter(s, "unfiltered_frames"), 1);
+  EXPECT_EQ(statusCounter(s, "fallback_frames"), 1);
+  EXPECT_EQ(statusCounter(s, "rejected_detections"), 1);
 }

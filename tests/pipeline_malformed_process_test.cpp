@@ -15,6 +15,7 @@
 
 #include "dlslot/node.hpp"
 #include "message_samples.hpp"
+#include "dlslot/frame_accounting.hpp"
 #include "process_harness.hpp"
 
 using namespace dlslot;
@@ -123,12 +124,6 @@ int64_t refusedInLog(const std::vector<Bytes>& events) {
   return n;
 }
 
-int64_t counter(const process_status_t& s, const std::string& name) {
-  for (int i = 0; i < s.num_counters; ++i)
-    if (s.counter_names[i] == name) return s.counter_values[i];
-  return 0;
-}
-
 }  // namespace
 
 TEST(PipelineMalformedProcess, EveryNodeSurvivesCountsEveryCaseAndThePipelineFinishes) {
@@ -197,7 +192,7 @@ TEST(PipelineMalformedProcess, EveryNodeSurvivesCountsEveryCaseAndThePipelineFin
   // all but the duplicate and the out-of-order one are refused.
   EXPECT_EQ(refusedOn(last["tracker"], "SLOT_STATE"), sent("SLOT_STATE") - 2);
   // The player follows SLOT_STATE by its frame number only: the frames it never played are refused.
-  EXPECT_GE(counter(last["player"], "refused.SLOT_STATE.frame_range"), 2);
+  EXPECT_GE(statusCounter(last["player"], "refused.SLOT_STATE.frame_range"), 2);
   // The launcher follows SLOT_STATE and PROCESS_STATUS.
   const int64_t launcher = sent("SLOT_STATE") + sent("PROCESS_STATUS");
   EXPECT_NE(text.find("launcher: refused " + std::to_string(launcher) + " messages"), std::string::npos) << text;

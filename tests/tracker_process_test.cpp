@@ -15,6 +15,7 @@
 #include "dlslot/odometry_t.hpp"
 #include "dlslot/process_status_t.hpp"
 #include "dlslot/slot_state_t.hpp"
+#include "dlslot/frame_accounting.hpp"
 #include "process_harness.hpp"
 
 using namespace dlslot;
@@ -44,12 +45,6 @@ std::string configWithTimeout(const std::string& dir, double timeout_s) {
   const std::string path = dir + "/dlslot.yaml";
   std::ofstream(path) << text;
   return path;
-}
-
-int64_t counter(const process_status_t& s, const std::string& name) {
-  for (int i = 0; i < s.num_counters; ++i)
-    if (s.counter_names[i] == name) return s.counter_values[i];
-  return 0;
 }
 
 Pose egoAt(int frame) {
@@ -167,9 +162,9 @@ TEST(TrackerProcess, LockstepFramesWithFaults) {
   EXPECT_GE(s.decode_errors, 1);
   EXPECT_GE(s.timeouts, 1);
   EXPECT_GE(s.frame_gaps, 1);
-  EXPECT_EQ(counter(s, "rejected_detections"), 2);
-  EXPECT_EQ(counter(s, "odometry_missing"), 1);
-  EXPECT_EQ(counter(s, "tracks_started"), 1);
+  EXPECT_EQ(statusCounter(s, "rejected_detections"), 2);
+  EXPECT_EQ(statusCounter(s, "odometry_missing"), 1);
+  EXPECT_EQ(statusCounter(s, "tracks_started"), 1);
 }
 
 TEST(TrackerProcess, BadConfigIsRefused) {

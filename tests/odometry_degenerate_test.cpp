@@ -10,13 +10,6 @@
 namespace dlslot::odometry {
 namespace {
 
-Frame frameOf(int index, PointCloud scan) {
-  Frame f;
-  f.index = index;
-  f.scan = std::move(scan);
-  return f;
-}
-
 PointCloud groundOnly() {
   test::Scene ground;
   ground.ground_z = -1.73;
@@ -26,7 +19,7 @@ PointCloud groundOnly() {
 TEST(OdometryDegenerate, FirstScansUnusable) {
   LidarOdometry odometry;
   for (const PointCloud& scan : {PointCloud(4, 0), PointCloud(PointCloud::Constant(4, 3000, NAN)), groundOnly()}) {
-    const OdometryResult r = odometry.process(frameOf(0, scan));
+    const OdometryResult r = odometry.process(test::frameOf(0, scan));
     EXPECT_EQ(r.status, Status::FallbackFewPoints);
     EXPECT_FALSE(r.status_text.empty());
     EXPECT_TRUE(r.T_world_lidar.isApprox(Pose::Identity()));
@@ -43,7 +36,7 @@ TEST(OdometryDegenerate, BadScanInTheMiddleFallsBackToConstantVelocity) {
     PointCloud scan = street.scan(T);
     if (i == 4) scan = PointCloud(4, 0);                                           // dropped scan
     if (i == 5) scan.setConstant(std::numeric_limits<float>::quiet_NaN());         // garbage
-    const OdometryResult r = odometry.process(frameOf(i, scan));
+    const OdometryResult r = odometry.process(test::frameOf(i, scan));
     if (i == 4 || i == 5) {
       EXPECT_EQ(r.status, Status::FallbackFewPoints) << "frame " << i;
       EXPECT_NE(r.status_text.find("too few"), std::string::npos);
@@ -61,9 +54,9 @@ TEST(OdometryDegenerate, BadScanInTheMiddleFallsBackToConstantVelocity) {
 TEST(OdometryDegenerate, SinglePlaneAfterGoodScansIsHandled) {
   const test::Scene street = test::street();
   LidarOdometry odometry;
-  odometry.process(frameOf(0, street.scan(Pose::Identity())));
-  odometry.process(frameOf(1, street.scan(test::planarPose(1.0, 0, 0))));
-  const OdometryResult r = odometry.process(frameOf(2, groundOnly()));
+  odometry.process(test::frameOf(0, street.scan(Pose::Identity())));
+  odometry.process(test::frameOf(1, street.scan(test::planarPose(1.0, 0, 0))));
+  const OdometryResult r = odometry.process(test::frameOf(2, groundOnly()));
   EXPECT_NE(r.status, Status::Ok);  // no edges at all: nothing to register
   EXPECT_TRUE(r.T_world_lidar.matrix().allFinite());
   EXPECT_NEAR(r.T_world_lidar.translation().x(), 2.0, 0.05);
@@ -72,11 +65,11 @@ TEST(OdometryDegenerate, SinglePlaneAfterGoodScansIsHandled) {
 TEST(OdometryDegenerate, ResetStartsOver) {
   const test::Scene street = test::street();
   LidarOdometry odometry;
-  odometry.process(frameOf(0, street.scan(Pose::Identity())));
-  odometry.process(frameOf(1, street.scan(test::planarPose(1.0, 0, 0))));
+  odometry.process(test::frameOf(0, street.scan(Pose::Identity())));
+  odometry.process(test::frameOf(1, street.scan(test::planarPose(1.0, 0, 0))));
   odometry.reset();
   EXPECT_TRUE(odometry.map().empty());
-  const OdometryResult r = odometry.process(frameOf(0, street.scan(test::planarPose(1.0, 0, 0))));
+  const OdometryResult r = odometry.process(test::frameOf(0, street.scan(test::planarPose(1.0, 0, 0))));
   EXPECT_EQ(r.status, Status::FirstFrame);
   EXPECT_TRUE(r.T_world_lidar.isApprox(Pose::Identity()));
 }

@@ -14,13 +14,6 @@
 namespace dlslot::odometry {
 namespace {
 
-Frame frameOf(int index, PointCloud scan) {
-  Frame f;
-  f.index = index;
-  f.scan = std::move(scan);
-  return f;
-}
-
 TEST(OdometryFallbackRecovery, VelocityHeldForAFewFramesThenBrakesToAStop) {
   const Pose v = test::planarPose(0.8, 0.6, 0.05);  // 1 m a frame, turning
   for (int n = 1; n < kFallbackHoldFrames; ++n) EXPECT_TRUE(fallbackVelocity(v, n).isApprox(v));
@@ -59,7 +52,7 @@ TEST(OdometryFallbackRecovery, StopsDuringADropoutAndRecoversWhenScansReturn) {
   for (int i = 0; i < 36; ++i) {
     const Pose T = test::planarPose(truthX(i), 0.0, 0.0);
     const bool lost = i >= 6 && i < 30;
-    const OdometryResult r = odometry.process(frameOf(i, lost ? PointCloud(4, 0) : street.scan(T)));
+    const OdometryResult r = odometry.process(test::frameOf(i, lost ? PointCloud(4, 0) : street.scan(T)));
     if (lost) {
       EXPECT_EQ(r.status, Status::FallbackFewPoints) << "frame " << i;
       // The guess moves on for a few frames, then brakes to a stop instead of driving away.
@@ -96,7 +89,7 @@ TEST(OdometryFallbackRecovery, KeepsItsSpeedThroughADropoutAndRecovers) {
   for (int i = 0; i < 24; ++i) {
     const Pose T = test::planarPose(1.5 * i, 0.0, 0.0);
     const bool lost = i >= 6 && i < 21;
-    const OdometryResult r = odometry.process(frameOf(i, lost ? PointCloud(4, 0) : street.scan(T)));
+    const OdometryResult r = odometry.process(test::frameOf(i, lost ? PointCloud(4, 0) : street.scan(T)));
     if (lost) continue;
     EXPECT_EQ(r.status, i == 0 ? Status::FirstFrame : Status::Ok) << "frame " << i << ": " << r.status_text;
     EXPECT_LT((r.T_world_lidar.translation() - T.translation()).norm(), 0.1) << "frame " << i;
@@ -115,7 +108,7 @@ TEST(OdometryFallbackRecovery, SingleFarSolutionStillRejected) {
   LidarOdometry odometry(cfg);
   for (int i = 0; i < 10; ++i) {
     const double x = i == 5 ? 5.8 : i;  // frame 5 seen 0.8 m from where the vehicle is
-    const OdometryResult r = odometry.process(frameOf(i, street.scan(test::planarPose(x, 0.0, 0.0))));
+    const OdometryResult r = odometry.process(test::frameOf(i, street.scan(test::planarPose(x, 0.0, 0.0))));
     if (i == 5) {
       EXPECT_EQ(r.status, Status::FallbackSolveFailed) << r.status_text;
       EXPECT_NE(r.status_text.find("jumped"), std::string::npos) << r.status_text;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "dlslot/types.hpp"
@@ -111,6 +112,14 @@ inline Pose planarPose(double x, double y, double yaw_rad) {
   T.linear() = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   T.translation() = Eigen::Vector3d(x, y, 0.0);
   return T;
+}
+
+// A frame of the odometry's input: scan number `index`, no detections.
+inline Frame frameOf(int index, PointCloud scan) {
+  Frame f;
+  f.index = index;
+  f.scan = std::move(scan);
+  return f;
 }
 
 }  // namespace dlslot::odometry::test

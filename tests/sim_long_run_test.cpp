@@ -13,17 +13,12 @@
 #include "dlslot/kitti.hpp"
 #include "sim/sim.hpp"
 #include "sim/simulation.hpp"
+#include "sim_scenario.hpp"
 
 namespace fs = std::filesystem;
 using namespace dlslot;
 
 namespace {
-
-sim::Scenario scenario(const std::string& name, int frames) {
-  sim::Scenario sc = sim::loadScenario(std::string(DLSLOT_SOURCE_DIR) + "/config/scenarios/" + name + ".yaml");
-  sc.frames = frames;
-  return sc;
-}
 
 // The scan of one frame with every object in range, as Simulation::frame makes it (which only
 // makes frames in order: 1000 of them would take minutes).
@@ -70,12 +65,12 @@ class FileSizeLimit {
 
 TEST(SimLongRun, EgoAtTheEndOfItsRoadStillSeesTheWorld) {
   // highway.yaml is written for 300 frames; at 1000 the ego reaches the end of its road.
-  const sim::Simulation s(scenario("highway", 1000));
+  const sim::Simulation s(sim::test::shippedScenario("highway", 1000));
   const int end = s.motion().ego_path_end_frame;
   ASSERT_GT(end, 400);
   ASSERT_LT(end, 800);
-  EXPECT_EQ(scenario("highway", 300).frames, 300);
-  EXPECT_EQ(sim::Simulation(scenario("highway", 300)).motion().ego_path_end_frame, -1);  // as written: never
+  EXPECT_EQ(sim::test::shippedScenario("highway", 300).frames, 300);
+  EXPECT_EQ(sim::Simulation(sim::test::shippedScenario("highway", 300)).motion().ego_path_end_frame, -1);  // as written: never
   // Standing: the last 100 frames move the lidar by centimetres at most (its body still rocks).
   EXPECT_LT((s.motion().ego[999].translation() - s.motion().ego[899].translation()).head<2>().norm(), 0.05);
   for (int f : {end, 999}) {
@@ -96,7 +91,7 @@ TEST(SimLongRun, EgoAtTheEndOfItsRoadStillSeesTheWorld) {
 TEST(SimLongRun, WritesTheDiskCannotHoldAreErrorsNamingTheFile) {
   const fs::path dir = fs::temp_directory_path() / ("dlslot_sim_long_run_" + std::to_string(::getpid()));
   fs::remove_all(dir);
-  const sim::Scenario sc = scenario("highway", 2);
+  const sim::Scenario sc = sim::test::shippedScenario("highway", 2);
   std::string error;
   {
     const FileSizeLimit limit(256 * 1024);  // a scan is ~1.7 MB

@@ -9,6 +9,7 @@
 #include "dlslot/kitti.hpp"
 #include "sim/rng.hpp"
 #include "sim/simulation.hpp"
+#include "sim_scenario.hpp"
 
 using namespace dlslot;
 
@@ -17,8 +18,7 @@ namespace {
 // The ideal lidar of issue 3: these tests check the ray caster's geometry; the imperfections of
 // issue 15 are checked in sim_sensor_model_test.cpp.
 sim::Scenario scenario(const std::string& name, int frames) {
-  sim::Scenario sc = sim::loadScenario(std::string(DLSLOT_SOURCE_DIR) + "/config/scenarios/" + name + ".yaml");
-  sc.frames = frames;
+  sim::Scenario sc = sim::test::shippedScenario(name, frames);
   sc.sensor = sim::idealSensor(sc.sensor);
   return sc;
 }

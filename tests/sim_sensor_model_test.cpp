@@ -10,18 +10,13 @@
 
 #include "sim/rng.hpp"
 #include "sim/simulation.hpp"
+#include "sim_scenario.hpp"
 
 using namespace dlslot;
 
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-
-sim::Scenario scenario(const std::string& name, int frames) {
-  sim::Scenario sc = sim::loadScenario(std::string(DLSLOT_SOURCE_DIR) + "/config/scenarios/" + name + ".yaml");
-  sc.frames = frames;
-  return sc;
-}
 
 Eigen::Vector3d direction(double el, double az) {
   return {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)};
@@ -103,7 +98,7 @@ TEST(SimSensorModel, FiringPhaseChangesFromRevolutionToRevolution) {
   EXPECT_EQ(sim::azimuthPhase(s, 12345), 0.0);
 
   // In a scan, every point of a ring sits at its column's azimuth with this frame's phase.
-  sim::Simulation sim(scenario("urban-static", 2));
+  sim::Simulation sim(sim::test::shippedScenario("urban-static", 2));
   const int n = sim.scenario().sensor.azimuth_steps;
   double phases[2];
   for (int k = 0; k < 2; ++k) {
@@ -203,7 +198,7 @@ TEST(SimSensorModel, PorousSolidsStopRaysAtAnExponentialDepth) {
   EXPECT_NEAR(depth / hits, 0.6, 0.01);
   // The shipped street has porous crowns (spheres) and wire fences (thin boxes); switched off, none.
   for (const bool on : {true, false}) {
-    sim::Scenario sc = scenario("urban-static", 1);
+    sim::Scenario sc = sim::test::shippedScenario("urban-static", 1);
     if (!on) sc.sensor.vegetation_mean_free_path_m = sc.sensor.fences = 0;
     sim::Simulation sim(sc);
     int crowns = 0, fences = 0;
@@ -225,7 +220,7 @@ TEST(SimSensorModel, PorousSolidsStopRaysAtAnExponentialDepth) {
 // ray, fired at its column's time from where the lidar (and the object it hit) was then, to the
 // surface it names, plus the beam's range bias and noise whose normalized spread is 1.
 TEST(SimSensorModel, PointsLieOnTheirTrueRaysWithTheModelledNoise) {
-  sim::Simulation sim(scenario("urban-static", 2));
+  sim::Simulation sim(sim::test::shippedScenario("urban-static", 2));
   const sim::SensorSpec& sensor = sim.scenario().sensor;
   ASSERT_TRUE(sensor.motion_distortion);
   ASSERT_FALSE(sensor.deskewed);
@@ -287,7 +282,7 @@ TEST(SimSensorModel, PointsLieOnTheirTrueRaysWithTheModelledNoise) {
 // reference pose, a noise-free point is where its ray hit.
 TEST(SimSensorModel, DeskewedScansPutEachPointWhereItsRayHit) {
   for (const bool deskewed : {false, true}) {
-    sim::Scenario sc = scenario("urban-static", 2);  // two frames: the ego's motion through frame 0
+    sim::Scenario sc = sim::test::shippedScenario("urban-static", 2);  // two frames: the ego's motion through frame 0
     sc.sensor.deskewed = deskewed;
     sc.sensor.range_noise_m = sc.sensor.range_noise_per_100m = sc.sensor.footprint_noise = 0;
     sc.sensor.beam_range_bias_m = 0;
@@ -323,7 +318,7 @@ TEST(SimSensorModel, DeskewedScansPutEachPointWhereItsRayHit) {
 // Weak returns: of the returns a lossless sensor gets on the ground, the kept share in each
 // range band is the model's mean keep probability there (binomial, within 4 sigma).
 TEST(SimSensorModel, WeakReturnsAreLostAsTheModelSays) {
-  sim::Scenario lossless = scenario("urban-static", 1), lossy = lossless;
+  sim::Scenario lossless = sim::test::shippedScenario("urban-static", 1), lossy = lossless;
   lossless.sensor.dropout = 0;
   lossless.sensor.dropout_signal = 0;
   lossy.sensor.dropout = 0.02;

@@ -11,17 +11,12 @@
 #include "sim/oxts.hpp"
 #include "sim/sim.hpp"
 #include "sim/simulation.hpp"
+#include "sim_scenario.hpp"
 
 namespace fs = std::filesystem;
 using namespace dlslot;
 
 namespace {
-
-sim::Scenario scenario(const std::string& name, int frames) {
-  sim::Scenario sc = sim::loadScenario(std::string(DLSLOT_SOURCE_DIR) + "/config/scenarios/" + name + ".yaml");
-  sc.frames = frames;
-  return sc;
-}
 
 fs::path tempDir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("dlslot_sim_test_" + name + "_" + std::to_string(::getpid()));
@@ -54,7 +49,7 @@ uint64_t hashTree(const fs::path& root, std::map<std::string, uint64_t>* per_fil
 }  // namespace
 
 TEST(SimSequence, SameSeedSameBytesOtherSeedOtherBytes) {
-  const sim::Scenario sc = scenario("intersection", 4);
+  const sim::Scenario sc = sim::test::shippedScenario("intersection", 4);
   const fs::path a = tempDir("det_a"), b = tempDir("det_b"), c = tempDir("det_c");
   sim::writeSequence(sc, 4, 7, a.string(), "0000", {1, false});
   sim::writeSequence(sc, 4, 7, b.string(), "0000", {2, false});  // threads must not matter
@@ -69,7 +64,7 @@ TEST(SimSequence, SameSeedSameBytesOtherSeedOtherBytes) {
 
 // Writing a shorter sequence over a longer one leaves exactly the new one (no stale scans).
 TEST(SimSequence, RewritingAShorterSequenceLeavesNoStaleScans) {
-  const sim::Scenario sc = scenario("intersection", 5);
+  const sim::Scenario sc = sim::test::shippedScenario("intersection", 5);
   const fs::path dir = tempDir("rewrite");
   sim::writeSequence(sc, 5, 7, dir.string(), "0000", {2, false});
   sim::writeSequence(sc, 3, 7, dir.string(), "0000", {2, false});
@@ -82,7 +77,7 @@ TEST(SimSequence, RewritingAShorterSequenceLeavesNoStaleScans) {
 
 TEST(SimSequence, ReaderGetsBackTheGeneratedGroundTruth) {
   const int frames = 6;
-  const sim::Scenario sc = scenario("urban-static", frames);
+  const sim::Scenario sc = sim::test::shippedScenario("urban-static", frames);
   const fs::path dir = tempDir("gt");
   sim::writeSequence(sc, frames, sc.seed, dir.string(), "0003", {2, false});
   ASSERT_TRUE(fs::exists(dir / "scenario.yaml"));
@@ -142,7 +137,7 @@ TEST(SimSequence, ReaderGetsBackTheGeneratedGroundTruth) {
 
 TEST(SimSequence, OxtsRoundTripRecoversThePosesWithinAMillimetre) {
   // A whole highway drive (~700 m at 25 m/s, with slopes and a curve), through the oxts text file.
-  sim::Scenario sc = scenario("highway", 300);
+  sim::Scenario sc = sim::test::shippedScenario("highway", 300);
   // A rigid ride: the body's pitch and heave on its suspension would show in the rates checked
   // below (the IMU sits a lever arm away from the lidar and feels the heave's acceleration).
   sc.ego.body_pitch_roll = sc.ego.body_heave_m = 0;

@@ -9,19 +9,13 @@
 
 #include "dlslot/config.hpp"
 #include "sim/simulation.hpp"
+#include "sim_scenario.hpp"
 
 namespace fs = std::filesystem;
 using namespace dlslot;
 
 namespace {
 
-const std::string kScenarios = std::string(DLSLOT_SOURCE_DIR) + "/config/scenarios/";
-
-sim::Scenario scenario(const std::string& name, int frames) {
-  sim::Scenario sc = sim::loadScenario(kScenarios + name + ".yaml");
-  sc.frames = frames;
-  return sc;
-}
 
 std::string writeTemp(const std::string& text) {
   const fs::path p = fs::temp_directory_path() / ("dlslot_sim_scenario_" + std::to_string(::getpid()) + ".yaml");
@@ -86,7 +80,7 @@ TEST(SimScenario, BadFilesNameTheFileAndTheKey) {
 
 TEST(SimWorld, NoSolidsOverlapAndMotionIsSmooth) {
   for (const std::string name : {"urban-static", "intersection", "highway", "parking-lot"}) {
-    const sim::Scenario sc = scenario(name, 120);
+    const sim::Scenario sc = sim::test::shippedScenario(name, 120);
     const sim::World world = sim::buildWorld(sc);
     const sim::Motion motion = sim::simulateMotion(sc, world);
     ASSERT_EQ(static_cast<int>(motion.ego.size()), sc.frames);
@@ -123,7 +117,7 @@ TEST(SimWorld, NoSolidsOverlapAndMotionIsSmooth) {
 }
 
 TEST(SimWorld, HighwaySurroundsTheEgoWithCarsAtItsSpeed) {
-  const sim::Scenario sc = scenario("highway", 100);
+  const sim::Scenario sc = sim::test::shippedScenario("highway", 100);
   const sim::World world = sim::buildWorld(sc);
   const sim::Motion motion = sim::simulateMotion(sc, world);
   for (int f : {0, 50, 99}) {

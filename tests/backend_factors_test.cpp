@@ -10,6 +10,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "backend/backend_config.hpp"
+#include "backend/constant_acceleration_factor.hpp"
 #include "backend/constant_velocity_factor.hpp"
 #include "backend/dense_kernels.hpp"
 #include "backend/landmark_observation_factor.hpp"
@@ -222,6 +223,28 @@ TEST(BackendFactors, ConstantVelocityResidualAndJacobians) {
   const Eigen::VectorXd r = residual(f, {toBlock(planarPose(1, 0, 0)), toBlock(planarPose(1.2, 0, 0))});
   EXPECT_NEAR(r[0], 0.2, 1e-12);
   EXPECT_NEAR(r.norm(), 0.2, 1e-12);
+}
+
+TEST(BackendFactors, ConstantAccelerationResidualAndJacobians) {
+  std::mt19937 rng(10);
+  for (int i = 0; i < 10; ++i) {
+    const std::vector<Vector7> blocks{toBlock(randomPose(rng, 1.0, 0.3)), toBlock(randomPose(rng, 1.0, 0.3)),
+                                      toBlock(randomPose(rng, 1.0, 0.3))};
+    ConstantAccelerationFactor f(randomSqrtInfo(rng));
+    expectJacobiansMatchNumeric(f, blocks);
+  }
+  // Sigmas 0.01 m. 1.0, 1.1, 1.2 m per frame (constant acceleration), turning at a constant rate:
+  // no cost. 1.0, 1.1, 1.3: the acceleration grew by 0.1 m per frame^2 -> 10 sigmas along x.
+  const auto f = std::unique_ptr<ceres::CostFunction>(ConstantAccelerationFactor::Create(Eigen::Vector3d::Constant(0.01)));
+  const auto& ca = static_cast<const ConstantAccelerationFactor&>(*f);
+  EXPECT_LT(residual(ca, {toBlock(planarPose(1.0, 0, 0.05)), toBlock(planarPose(1.1, 0, 0.05)),
+                          toBlock(planarPose(1.2, 0, 0.05))})
+                .norm(),
+            1e-12);
+  const Eigen::VectorXd r =
+      residual(ca, {toBlock(planarPose(1.0, 0, 0)), toBlock(planarPose(1.1, 0, 0)), toBlock(planarPose(1.3, 0, 0))});
+  EXPECT_NEAR(r[0], 10.0, 1e-9);
+  EXPECT_NEAR(r.norm(), 10.0, 1e-9);
 }
 
 TEST(BackendFactors, VehicleMotionResidualAndJacobians) {

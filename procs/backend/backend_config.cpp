@@ -61,6 +61,14 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   c.pose_change_sigma = readSigmas(s, "pose_change_sigma");
   c.constant_velocity_sigma = readSigmas(s, "constant_velocity_sigma");
   c.first_pose_sigma = readSigmas(s, "first_pose_sigma");
+  {
+    std::vector<double> v;
+    s.get("constant_acceleration_sigma", v);
+    if (v.size() != 3 || !(v[0] > 0 && v[1] > 0 && v[2] > 0))
+      throw ConfigError(s.file() + ": " + s.path() +
+                        ".constant_acceleration_sigma: expected 3 standard deviations > 0 [x m, y m, z m]");
+    c.constant_acceleration_sigma = Eigen::Vector3d(v[0], v[1], v[2]);
+  }
   s.get("observation_sigma_growth_per_m", c.observation_sigma_growth_per_m);
   {
     std::vector<double> v;

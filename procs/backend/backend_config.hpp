@@ -29,7 +29,10 @@ struct BackendConfig {
   Vector6 observation_sigma = (Vector6() << 0.25, 0.15, 0.3, 0.3, 0.3, 0.1).finished();
   Vector6 landmark_sigma = (Vector6() << 0.15, 0.1, 0.3, 0.3, 0.3, 0.05).finished();
   Vector6 pose_change_sigma = (Vector6() << 0.02, 0.02, 0.02, 0.005, 0.005, 0.005).finished();
-  Vector6 constant_velocity_sigma = (Vector6() << 0.05, 0.03, 0.02, 0.005, 0.005, 0.01).finished();
+  Vector6 constant_velocity_sigma = (Vector6() << 0.05, 0.03, 0.02, 0.005, 0.005, 0.0005).finished();
+  // Second difference of a dynamic object's per-frame translation (constant_acceleration_factor.hpp),
+  // x y z in m; eq. 11's constant_velocity_sigma then bounds the acceleration itself.
+  Eigen::Vector3d constant_acceleration_sigma = Eigen::Vector3d(0.005, 0.005, 0.005);
   Vector6 first_pose_sigma = (Vector6() << 1e-3, 1e-3, 1e-3, 1e-4, 1e-4, 1e-4).finished();
   // The vehicle motion prior on every pose change of a vehicle (vehicle_motion_factor.hpp):
   // sigmas of its lateral and vertical translation (m) and roll and pitch (rad) per frame, and
@@ -59,9 +62,9 @@ struct BackendConfig {
   // (which box noise alone would cause); else it starts as a static landmark.
   double static_max_speed = 1.0;
   // A dynamic object's reported velocity: its optimized chain's displacement over the last this
-  // many frames (eq. 10-11's pose changes summed), not the newest pose change alone, which the
-  // window constrains from one side only and which carries one frame's box noise.
-  int velocity_frames = 5;
+  // many frames. With the constant-acceleration factor the newest pose change (1) is the best
+  // estimate; a longer chord lags behind a braking car by half its span.
+  int velocity_frames = 1;
   double dynamic_min_sigmas = 2.0;
   // A landmark turns dynamic when its last `switch_frames` observations each lie farther than
   // `switch_distance` (m, bird's-eye) from it (a parked car pulls out).

@@ -29,6 +29,22 @@ std::optional<SpeedFit> fitSpeed(const std::vector<TimedPosition>& positions, do
   return fit;
 }
 
+Eigen::Vector3d velocityAlongHeading(const SpeedFit& fit, const Eigen::Vector2d& heading, double heading_sigma) {
+  const Eigen::Vector2d v = fit.velocity.head<2>();
+  const Eigen::Vector2d across(-heading.y(), heading.x());
+  const double v_across = v.dot(across);
+  // A heading error d moves a velocity |v| sideways by |v| sin d.
+  const double var_heading = std::pow(v.norm() * heading_sigma, 2);
+  const double var_fit = fit.sigma * fit.sigma;
+  // No gate on disagreement: on intersection seed 1 rejecting the heading beyond 3 or 5 sigmas
+  // made velocities worse (0.358 -> 0.382 m/s); the boxes' heading is the better of the two there.
+  if (var_heading + var_fit <= 0.0) return fit.velocity;
+  const double w = var_heading / (var_heading + var_fit);  // weight of the positions' estimate
+  Eigen::Vector3d out = fit.velocity;
+  out.head<2>() -= (1.0 - w) * v_across * across;
+  return out;
+}
+
 bool leftLandmark(const std::vector<Eigen::Vector3d>& positions, const Eigen::Vector3d& landmark, double distance,
                   int n) {
   if (n <= 0 || static_cast<int>(positions.size()) < n) return false;

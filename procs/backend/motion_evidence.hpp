@@ -25,6 +25,12 @@ struct SpeedFit {
 // of a few sigmas is evidence of motion.
 std::optional<SpeedFit> fitSpeed(const std::vector<TimedPosition>& positions, double position_sigma);
 
+// A wheeled vehicle moves along its heading. The fit's velocity component across the unit
+// bird's-eye `heading` is that of positions alone (standard deviation fit.sigma); the heading
+// says it is zero, to within the speed times `heading_sigma` (rad). Returns the fit's velocity
+// with that component replaced by the variance-weighted mean of the two.
+Eigen::Vector3d velocityAlongHeading(const SpeedFit& fit, const Eigen::Vector2d& heading, double heading_sigma);
+
 // True when the last `n` positions all lie farther than `distance` (bird's-eye) from `landmark`
 // (false when there are fewer than n).
 bool leftLandmark(const std::vector<Eigen::Vector3d>& positions, const Eigen::Vector3d& landmark, double distance,

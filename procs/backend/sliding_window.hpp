@@ -80,6 +80,9 @@ class SlidingWindow {
   void addEgoFrame(const BackendInput& in);
   void addObservations(const BackendInput& in);
   void startTrack(Track& track, int frame);
+  // A track without a chain spanning the window: windowMotion, for a vehicle turned toward the
+  // mean heading of its boxes (velocityAlongHeading).
+  std::optional<Eigen::Vector3d> youngVelocity(const Track& track) const;
   // The least-squares motion of the track's observed positions in the window (world frame).
   std::optional<SpeedFit> windowMotion(const Track& track) const;
   void addTrackObservation(Track& track, int frame);

@@ -1,0 +1,43 @@
+// The window's motion evidence (motion_evidence.hpp): the least-squares line through a track's
+// positions and a vehicle's velocity turned toward its heading, against known answers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "backend/motion_evidence.hpp"
+
+using namespace dlslot::backend;
+
+TEST(BackendMotionEvidence, FitSpeedIsTheLeastSquaresLine) {
+  // 10 m/s along x with +-0.1 m alternating noise over 5 samples 0.1 s apart.
+  std::vector<TimedPosition> p;
+  for (int k = 0; k < 5; ++k) p.push_back({0.1 * k, Eigen::Vector3d(1.0 * k + (k % 2 ? 0.1 : -0.1), 2.0, 0.0)});
+  const auto fit = fitSpeed(p, 0.2);
+  ASSERT_TRUE(fit);
+  // Slope of y_k = k + e_k with e = (-.1, .1, -.1, .1, -.1): sum (t - 0.2) e / sum (t - 0.2)^2 = 0 / 0.1.
+  EXPECT_NEAR(fit->velocity.x(), 10.0, 1e-9);
+  EXPECT_NEAR(fit->velocity.y(), 0.0, 1e-12);
+  EXPECT_NEAR(fit->sigma, 0.2 / std::sqrt(0.1), 1e-12);
+  EXPECT_FALSE(fitSpeed({p[0]}, 0.2));
+}
+
+TEST(BackendMotionEvidence, VelocityAlongHeadingWeighsTheTwoEstimates) {
+  SpeedFit fit;
+  fit.velocity = Eigen::Vector3d(10.0, 1.0, 0.3);  // 1 m/s across a heading along x
+  fit.sigma = 0.5;
+  const Eigen::Vector2d x(1.0, 0.0);
+  // Heading sigma 0.05 rad at |v| = 10.05 m/s: 0.5025 m/s, about as uncertain as the fit.
+  const double var_h = std::pow(std::hypot(10.0, 1.0) * 0.05, 2), w = var_h / (var_h + 0.25);
+  Eigen::Vector3d v = velocityAlongHeading(fit, x, 0.05);
+  EXPECT_NEAR(v.x(), 10.0, 1e-12);
+  EXPECT_NEAR(v.y(), w * 1.0, 1e-12);
+  EXPECT_NEAR(v.y(), 0.5, 0.01);
+  EXPECT_NEAR(v.z(), 0.3, 1e-12);  // height untouched
+  // A sure heading removes the sideways part; a useless one keeps the fit.
+  EXPECT_NEAR(velocityAlongHeading(fit, x, 1e-9).y(), 0.0, 1e-9);
+  EXPECT_NEAR(velocityAlongHeading(fit, x, 1e3).y(), 1.0, 1e-6);
+  // The heading's sign does not matter (a box and the box turned by pi are the same box).
+  EXPECT_TRUE(velocityAlongHeading(fit, -x, 0.05).isApprox(v, 1e-12));
+  // A heading at 90 deg to the motion is believed as much: the 10 m/s across it is halved.
+  EXPECT_NEAR(velocityAlongHeading(fit, Eigen::Vector2d(0.0, 1.0), 0.05).x(), w * 10.0, 1e-9);
+}

@@ -72,6 +72,8 @@ DetectorConfig DetectorConfig::read(ConfigSection s) {
     k.get("min_profile_step_m", cl.min_profile_step_m);
     k.get("level_max_width_m", cl.level_max_width_m);
     k.get("max_vehicle_profile_step_m", cl.max_vehicle_profile_step_m);
+    k.get("cyclist_min_profile_step_m", cl.cyclist_min_profile_step_m);
+    k.get("vehicle_min_height_drop_per_m", cl.vehicle_min_height_drop_per_m);
     cl.car = readWindow(k.section("car"));
     cl.van = readWindow(k.section("van"));
     cl.truck = readWindow(k.section("truck"));
@@ -119,6 +121,9 @@ void DetectorConfig::validate() const {
        "clustering.neighbour_columns: expected 1..8");
   need(clustering.distance_m > 0 && clustering.distance_per_m >= 0, "clustering.distance_m: expected > 0");
   need(clustering.min_points >= 1, "clustering.min_points: expected >= 1");
+  need(classes.cyclist_min_profile_step_m >= 0, "classes.cyclist_min_profile_step_m: expected >= 0");
+  need(classes.vehicle_min_height_drop_per_m >= 0 && classes.vehicle_min_height_drop_per_m < 0.05,
+       "classes.vehicle_min_height_drop_per_m: expected in [0, 0.05)");
   need(classes.car_prior_length_m > 0 && classes.car_prior_width_m > 0, "classes.car_prior_size_m: expected > 0");
 }
 

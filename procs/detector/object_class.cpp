@@ -10,6 +10,10 @@ namespace {
 // How far (in tan of elevation) below the top beam a cluster's highest point may be and still
 // count as cut off by it (the HDL-64E's top beams are 0.0058 apart).
 constexpr double kTopMargin = 0.006;
+// A low cluster (under the car window's height) is a vehicle's back or front only when it is a face:
+// thinner than this bird's-eye and across the line of sight (its axis more than 65 deg from the ray).
+constexpr double kFaceMaxDepth_m = 0.8;
+const double kFaceMaxCos = std::cos(65.0 * M_PI / 180.0);
 // Within this range a van (2-2.5 m) reaches above the HDL-64E's top beam (1.73 m + 0.035 x range).
 constexpr double kBesideRange_m = 10.0;
 
@@ -102,11 +106,18 @@ std::optional<Box> classifyCluster(const ClusterShape& s_in, const ClassConfig& 
     return makeBox(seen, s, "Pedestrian", logit(confidence(s.num_points, 20, 1.0, 1.0)));
   // A cyclist seen from the side: a bicycle's length, a person's height, narrow.
   if (person_height && cfg.cyclist.contains(seen.length, seen.width, h) && h >= cfg.car.max_height_m - 0.3 &&
-      seen.length < cfg.car_side_min_m)
+      seen.length < cfg.car_side_min_m && s.profile_step >= cfg.cyclist_min_profile_step_m)
     return makeBox(seen, s, "Cyclist", logit(confidence(s.num_points, 25, 1.0, 1.0)));
 
   // Cars, also when partly seen: completed to the prior, then checked against the car window.
-  const bool vehicle_height = h >= cfg.car.min_height_m && h <= cfg.van.max_height_m;
+  const double vehicle_min_height =
+      cfg.car.min_height_m - cfg.vehicle_min_height_drop_per_m * seen.center.norm();
+  // Below the car window's own lower end only a back or a front is taken (a thin face across the
+  // line of sight): far guard rails and kerbside bushes are as low but run along the rays or are blobs.
+  const Eigen::Vector2d radial = seen.center.norm() > 1e-6 ? Eigen::Vector2d(seen.center.normalized()) : Eigen::Vector2d(1, 0);
+  const bool low_face = seen.width < kFaceMaxDepth_m && std::abs(axisOf(seen.yaw).dot(radial)) < kFaceMaxCos;
+  const bool vehicle_height = h <= cfg.van.max_height_m &&
+                              (h >= cfg.car.min_height_m || cut_at_top || (h >= vehicle_min_height && low_face));
   if (vehicle_height && !ragged_top && seen.length >= cfg.min_vehicle_face_m && seen.length <= cfg.van.max_length_m && seen.width <= cfg.van.max_width_m) {
     // Neither a side nor a back seen but a blob of both: a corner (an L) only when the points lie on
     // its edges; foliage fills it.
@@ -120,7 +131,8 @@ std::optional<Box> classifyCluster(const ClusterShape& s_in, const ClassConfig& 
     const double share = seen_area / std::max(1e-6, full.length * full.width) +
                          0.5 * std::max(seen.length, seen.width) / full.length;
     const double score = logit(confidence(s.num_points, 40, std::max(0.3, seen.edge_fraction), share));
-    if (cfg.car.contains(full.length, full.width, h, cut_at_top)) return makeBox(full, s, "Car", score);
+    // vehicle_height has checked the lower end (dropping with range), so the window's is not used.
+    if (cfg.car.contains(full.length, full.width, h, /*height_is_lower_bound=*/true)) return makeBox(full, s, "Car", score);
     if (cfg.van.contains(full.length, full.width, h, cut_at_top)) return makeBox(full, s, "Van", score);
   }
 

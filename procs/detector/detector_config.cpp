@@ -92,6 +92,7 @@ DetectorConfig DetectorConfig::read(ConfigSection s) {
     cl.top_tan = std::tan(cl.top_tan * M_PI / 180.0);
     k.finish();
   }
+  c.scores = ScoreCalibration::read(s.section("score_calibration"));
   s.finish();
   try {
     c.validate();

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "detector/score_calibration.hpp"
 #include "dlslot/config.hpp"
 
 namespace dlslot::detector {
@@ -96,6 +97,7 @@ struct DetectorConfig {
   GroundConfig ground;
   ClusteringConfig clustering;
   ClassConfig classes;
+  ScoreCalibration scores;
 
   // Throws ConfigError naming the file and the key.
   static DetectorConfig read(ConfigSection section);

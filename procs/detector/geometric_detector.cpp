@@ -78,6 +78,7 @@ DetectionResult detectObjects(const PointCloud& scan, const DetectorConfig& cfg)
     // cluster that starts below the fitted ground stands in a dip).
     shape.ground_z = std::min(shape.ground_z, shape.min_z);
     if (std::optional<Box> box = classifyCluster(shape, cfg.classes)) {
+      box->score = cfg.scores.apply(box->type, box->score);  // on PointRCNN's scale (score_calibration.hpp)
       ++out.per_type[box->type];
       out.boxes.push_back(std::move(*box));
       out.shapes.push_back(shape);

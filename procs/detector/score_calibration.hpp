@@ -1,0 +1,37 @@
+// Detection scores on PointRCNN's scale. The detector's own score (the logit of a confidence from
+// the fit, object_class.cpp) says little about how often a box is right, and the tracker's
+// thresholds (tracker.classes.*.min_score) were chosen for PointRCNN's logits. So each class
+// group maps its raw score through a table measured offline (scripts/score-calibration.py): a
+// raw score whose detections were right with precision p becomes the PointRCNN score at which
+// PointRCNN's detections were right with the same p. Then one tracker policy fits both sources,
+// and a detection file written by the detector means what a PointRCNN file means.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "dlslot/config.hpp"
+
+namespace dlslot::detector {
+
+// A monotone piecewise-linear map raw -> calibrated through the knots (raw strictly increasing,
+// calibrated non-decreasing), constant beyond the first and last knot.
+struct ScoreTable {
+  std::vector<double> raw, calibrated;
+  double operator()(double raw_score) const;
+  // Throws std::invalid_argument naming what is wrong (empty, sizes differ, not monotone).
+  void validate() const;
+};
+
+// One table per class group: vehicle (Car, Van, Truck), pedestrian (Pedestrian), cyclist
+// (Cyclist). Other types (Unknown: never tracked) keep their raw score.
+struct ScoreCalibration {
+  ScoreTable vehicle{{0.0, 1.0}, {0.0, 1.0}}, pedestrian{{0.0, 1.0}, {0.0, 1.0}}, cyclist{{0.0, 1.0}, {0.0, 1.0}};
+  double apply(const std::string& type, double raw_score) const;
+
+  // The `score_calibration` section: {vehicle: {raw: [...], calibrated: [...]}, pedestrian: ..., cyclist: ...}.
+  // Throws ConfigError naming the file and the key.
+  static ScoreCalibration read(ConfigSection section);
+};
+
+}  // namespace dlslot::detector

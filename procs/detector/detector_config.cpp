@@ -74,6 +74,8 @@ DetectorConfig DetectorConfig::read(ConfigSection s) {
     k.get("max_vehicle_profile_step_m", cl.max_vehicle_profile_step_m);
     k.get("cyclist_min_profile_step_m", cl.cyclist_min_profile_step_m);
     k.get("vehicle_min_height_drop_per_m", cl.vehicle_min_height_drop_per_m);
+    k.get("truck_min_face_m", cl.truck_min_face_m);
+    k.get("truck_prior_length_m", cl.truck_prior_length_m);
     cl.car = readWindow(k.section("car"));
     cl.van = readWindow(k.section("van"));
     cl.truck = readWindow(k.section("truck"));
@@ -125,6 +127,8 @@ void DetectorConfig::validate() const {
   need(classes.cyclist_min_profile_step_m >= 0, "classes.cyclist_min_profile_step_m: expected >= 0");
   need(classes.vehicle_min_height_drop_per_m >= 0 && classes.vehicle_min_height_drop_per_m < 0.05,
        "classes.vehicle_min_height_drop_per_m: expected in [0, 0.05)");
+  need(classes.truck_min_face_m > 0 && classes.truck_prior_length_m > 0,
+       "classes.truck_min_face_m, truck_prior_length_m: expected > 0");
   need(classes.car_prior_length_m > 0 && classes.car_prior_width_m > 0, "classes.car_prior_size_m: expected > 0");
 }
 

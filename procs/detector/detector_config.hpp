@@ -78,6 +78,9 @@ struct ClassConfig {
   // beams are ~0.2 m apart at the roof and the ground under the vehicle is hidden by it, so the
   // ground line climbs its lower body (highway seeds 1-5: cars at 25-40 m seen 0.6-1.0 m tall).
   double vehicle_min_height_drop_per_m = 0.008;
+  // A truck's back: a face at least this wide (wider than cars and vans), completed to this length.
+  double truck_min_face_m = 2.3;
+  double truck_prior_length_m = 8.0;
   SizeWindow car{3.2, 5.4, 1.4, 2.2, 1.0, 1.9};
   SizeWindow van{4.2, 6.5, 1.7, 2.4, 1.9, 2.8};
   SizeWindow truck{6.0, 14.0, 2.0, 3.0, 2.5, 4.2};

@@ -14,6 +14,8 @@ constexpr double kTopMargin = 0.006;
 // thinner than this bird's-eye and across the line of sight (its axis more than 65 deg from the ray).
 constexpr double kFaceMaxDepth_m = 0.8;
 const double kFaceMaxCos = std::cos(65.0 * M_PI / 180.0);
+// A truck's back is a plane: at least this share of its points on the rectangle's edges.
+constexpr double kTruckBackEdgeFraction = 0.8;
 // Within this range a van (2-2.5 m) reaches above the HDL-64E's top beam (1.73 m + 0.035 x range).
 constexpr double kBesideRange_m = 10.0;
 
@@ -69,6 +71,31 @@ Rectangle completeVehicle(const Rectangle& seen, double prior_length_m, double p
   return r;
 }
 
+namespace {
+
+std::optional<Box> truckBack(const ClusterShape& s, bool cut_at_top, const ClassConfig& cfg) {
+  const Rectangle& seen = s.seen;
+  const double h = s.max_z - s.ground_z;
+  if (seen.center.norm() < 1e-6 || s.profile_step > cfg.max_vehicle_profile_step_m) return std::nullopt;
+  // Tall (a truck's window's height, less what the top beam may have cut off) and a clean plane: its
+  // points on the rectangle's edges (roadside trees and bushes as wide and tall have few there).
+  const double min_h = cut_at_top ? cfg.van.max_height_m - 0.5 : cfg.truck.min_height_m;
+  if (h < min_h || h > cfg.truck.max_height_m || seen.edge_fraction < kTruckBackEdgeFraction) return std::nullopt;
+  const Eigen::Vector2d radial = seen.center.normalized();
+  // The rectangle's side across the line of sight is the back; the other runs away from the sensor.
+  const bool length_across = std::abs(axisOf(seen.yaw).dot(radial)) < std::abs(axisOf(seen.yaw + M_PI / 2).dot(radial));
+  const double face = length_across ? seen.length : seen.width, depth = length_across ? seen.width : seen.length;
+  if (face < cfg.truck_min_face_m || face > cfg.truck.max_width_m || depth >= cfg.truck.min_length_m) return std::nullopt;
+  Rectangle r = seen;
+  r.length = depth;
+  r.width = face;
+  r.yaw = length_across ? seen.yaw + M_PI / 2 : seen.yaw;
+  const Rectangle full = completeVehicle(r, cfg.truck_prior_length_m, face, 0.0);
+  return makeBox(full, s, "Truck", logit(confidence(s.num_points, 60, seen.edge_fraction, depth / full.length)));
+}
+
+}  // namespace
+
 std::optional<Box> classifyCluster(const ClusterShape& s_in, const ClassConfig& cfg) {
   ClusterShape s = s_in;
   const double bottom = s.min_z - s.ground_z;
@@ -88,6 +115,10 @@ std::optional<Box> classifyCluster(const ClusterShape& s_in, const ClassConfig& 
   // the ego (a van there shows a level band). (A wide L-shape is a corner, level or not: a partly
   // seen car shows only its roof's rear part.)
   const bool cut_beside = cut_at_top && seen.center.norm() < kBesideRange_m;
+  // A truck's or a bus's back from behind (highway seeds 1-5: 67 of the vehicle misses, a truck
+  // 28-38 m ahead): a face wider than any car or van, across the line of sight, tall or cut by the
+  // top beam, seen less deep than a truck is long. Completed away from the sensor to the truck prior.
+  if (std::optional<Box> back = truckBack(s, cut_at_top, cfg)) return back;
   const bool level_side = seen.length >= cfg.car_side_min_m && seen.width < cfg.level_max_width_m && !cut_beside &&
                           s.profile_step < cfg.min_profile_step_m;
   if (level_side) return std::nullopt;

@@ -85,10 +85,10 @@ TEST(ScoreCalibrationTest, ShippedTablesAreTheDefaultsAndBadOnesNameTheKey) {
 
   std::ifstream in(shippedConfig());
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string from = "calibrated: [-0.12, 2.59, 4.36, 4.88]";
+  const std::string from = "calibrated: [-0.26, 2.6, 4.71, 5.28]";
   const size_t at = text.find(from);
   ASSERT_NE(at, std::string::npos);
-  text.replace(at, from.size(), "calibrated: [-0.12, 2.59, 4.36, 1.0]");
+  text.replace(at, from.size(), "calibrated: [-0.26, 2.6, 4.71, 1.0]");
   const std::string path = testing::TempDir() + "/score_calibration_test.yaml";
   std::ofstream(path) << text;
   ConfigSection bad = loadConfig(path);
@@ -133,8 +133,9 @@ TEST(ScoreCalibrationTest, PlainlySeenObjectsPassTheTrackersThresholds) {
   // With the raw scores (identity table) the car would start no track: what issue 18 was about.
   DetectorConfig raw = det_cfg;
   raw.scores.vehicle = {{-10.0, 10.0}, {-10.0, 10.0}};
-  for (const Box& b : detectObjects(scene.scan(), raw).boxes)
+  for (const Box& b : detectObjects(scene.scan(), raw).boxes) {
     if (b.type == "Car") EXPECT_LT(b.score, minScore("Car"));
+  }
 }
 
 TEST(DetectorClassRules, AVansLevelBackIsNoCyclistButARiderAboveWheelsIs) {

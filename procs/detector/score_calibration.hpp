@@ -27,7 +27,7 @@ struct ScoreTable {
 // (Cyclist). Other types (Unknown: never tracked) keep their raw score.
 struct ScoreCalibration {
   // The shipped tables (config/dlslot.yaml), so tests can start from DetectorConfig{}.
-  ScoreTable vehicle{{0.42, 0.71, 1.28, 2.56}, {-0.12, 2.59, 4.36, 4.88}};
+  ScoreTable vehicle{{0.42, 0.71, 1.29, 2.56}, {-0.26, 2.6, 4.71, 5.28}};
   ScoreTable pedestrian{{0.83, 1.32, 2.06, 5.11}, {1.99, 3.83, 4.22, 5.67}};
   ScoreTable cyclist{{2.75, 5.26}, {-0.45, 6.81}};
   double apply(const std::string& type, double raw_score) const;

@@ -134,7 +134,9 @@ TEST(ScoreCalibrationTest, PlainlySeenObjectsPassTheTrackersThresholds) {
   DetectorConfig raw = det_cfg;
   raw.scores.vehicle = {{-10.0, 10.0}, {-10.0, 10.0}};
   for (const Box& b : detectObjects(scene.scan(), raw).boxes) {
-    if (b.type == "Car") EXPECT_LT(b.score, minScore("Car"));
+    if (b.type == "Car") {
+      EXPECT_LT(b.score, minScore("Car"));
+    }
   }
 }
 

@@ -166,3 +166,27 @@ TEST(DetectorClassRules, AFarLowBackIsACarButALowRailAlongTheRaysIsNot) {
   const std::optional<Box> rail = classifyCluster(shapeAt(35.0, 3.0, 2.0, 0.1, 0.05, 0.8, 0.45, 0.05, 20), cfg);
   EXPECT_TRUE(!rail || (rail->type != "Car" && rail->type != "Van"));
 }
+
+TEST(DetectorClassRules, PeopleAndCyclistsGrowToTheirPriorFootprintAboutTheirCentre) {
+  const ClassConfig cfg;
+  // The near half of a person 10 m ahead: 0.45 x 0.3 m seen (3-D IoU with a 0.8 x 0.6 m label < 0.25).
+  const std::optional<Box> p = classifyCluster(shapeAt(10.0, 2.0, 0.45, 0.3, 0.2, 1.7, 0.0, 0.1, 80), cfg);
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->type, "Pedestrian");
+  EXPECT_DOUBLE_EQ(p->size.x(), cfg.pedestrian_prior_length_m);
+  EXPECT_DOUBLE_EQ(p->size.y(), cfg.pedestrian_prior_width_m);
+  EXPECT_DOUBLE_EQ(p->center.x(), 10.0);
+  EXPECT_DOUBLE_EQ(p->center.y(), 2.0);
+  // A person seen larger than the prior keeps the seen size.
+  const std::optional<Box> wide = classifyCluster(shapeAt(10.0, 2.0, 0.95, 0.7, 0.2, 1.7, 0.0, 0.1, 80), cfg);
+  ASSERT_TRUE(wide);
+  EXPECT_EQ(wide->type, "Pedestrian");
+  EXPECT_DOUBLE_EQ(wide->size.x(), 0.95);
+  EXPECT_DOUBLE_EQ(wide->size.y(), 0.7);
+  // A cyclist's side: completed to the cyclist prior's width.
+  const std::optional<Box> c = classifyCluster(shapeAt(15.0, 0.0, 1.8, 0.3, M_PI / 2, 1.8, 0.0, 0.8, 60), cfg);
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->type, "Cyclist");
+  EXPECT_DOUBLE_EQ(c->size.x(), 1.8);
+  EXPECT_DOUBLE_EQ(c->size.y(), cfg.cyclist_prior_width_m);
+}

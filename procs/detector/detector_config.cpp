@@ -76,6 +76,16 @@ DetectorConfig DetectorConfig::read(ConfigSection s) {
     k.get("vehicle_min_height_drop_per_m", cl.vehicle_min_height_drop_per_m);
     k.get("truck_min_face_m", cl.truck_min_face_m);
     k.get("truck_prior_length_m", cl.truck_prior_length_m);
+    auto readPrior = [&](const std::string& key, double& l, double& w) {
+      std::vector<double> v;
+      k.get(key, v);
+      if (v.size() != 2 || !(v[0] > 0) || !(v[1] > 0))
+        throw ConfigError(k.file() + ": " + k.path() + "." + key + ": expected [length, width], both > 0");
+      l = v[0];
+      w = v[1];
+    };
+    readPrior("pedestrian_prior_size_m", cl.pedestrian_prior_length_m, cl.pedestrian_prior_width_m);
+    readPrior("cyclist_prior_size_m", cl.cyclist_prior_length_m, cl.cyclist_prior_width_m);
     cl.car = readWindow(k.section("car"));
     cl.van = readWindow(k.section("van"));
     cl.truck = readWindow(k.section("truck"));

@@ -73,6 +73,16 @@ Rectangle completeVehicle(const Rectangle& seen, double prior_length_m, double p
 
 namespace {
 
+// A person's or a cyclist's box grown to at least the prior footprint about its seen centre. (Moving
+// the centre away from the sensor by half the gained depth, as for vehicles, put the centres 3 cm
+// farther from the labels' on intersection seed 1: people are seen nearly whole in depth.)
+Rectangle completeSmall(const Rectangle& seen, double prior_length_m, double prior_width_m) {
+  Rectangle r = seen;
+  r.length = std::max(seen.length, prior_length_m);
+  r.width = std::max(seen.width, prior_width_m);
+  return r;
+}
+
 std::optional<Box> truckBack(const ClusterShape& s, bool cut_at_top, const ClassConfig& cfg) {
   const Rectangle& seen = s.seen;
   const double h = s.max_z - s.ground_z;
@@ -134,11 +144,13 @@ std::optional<Box> classifyCluster(const ClusterShape& s_in, const ClassConfig& 
   // People: small footprint, person height, not cut off by the top beam (so not a pole or a wall).
   const bool person_height = !cut_at_top;
   if (person_height && cfg.pedestrian.contains(seen.length, seen.width, h))
-    return makeBox(seen, s, "Pedestrian", logit(confidence(s.num_points, 20, 1.0, 1.0)));
+    return makeBox(completeSmall(seen, cfg.pedestrian_prior_length_m, cfg.pedestrian_prior_width_m), s, "Pedestrian",
+                   logit(confidence(s.num_points, 20, 1.0, 1.0)));
   // A cyclist seen from the side: a bicycle's length, a person's height, narrow.
   if (person_height && cfg.cyclist.contains(seen.length, seen.width, h) && h >= cfg.car.max_height_m - 0.3 &&
       seen.length < cfg.car_side_min_m && s.profile_step >= cfg.cyclist_min_profile_step_m)
-    return makeBox(seen, s, "Cyclist", logit(confidence(s.num_points, 25, 1.0, 1.0)));
+    return makeBox(completeSmall(seen, cfg.cyclist_prior_length_m, cfg.cyclist_prior_width_m), s, "Cyclist",
+                   logit(confidence(s.num_points, 25, 1.0, 1.0)));
 
   // Cars, also when partly seen: completed to the prior, then checked against the car window.
   const double vehicle_min_height =

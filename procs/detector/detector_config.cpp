@@ -72,6 +72,20 @@ DetectorConfig DetectorConfig::read(ConfigSection s) {
     k.get("min_profile_step_m", cl.min_profile_step_m);
     k.get("level_max_width_m", cl.level_max_width_m);
     k.get("max_vehicle_profile_step_m", cl.max_vehicle_profile_step_m);
+    k.get("cyclist_min_profile_step_m", cl.cyclist_min_profile_step_m);
+    k.get("vehicle_min_height_drop_per_m", cl.vehicle_min_height_drop_per_m);
+    k.get("truck_min_face_m", cl.truck_min_face_m);
+    k.get("truck_prior_length_m", cl.truck_prior_length_m);
+    auto readPrior = [&](const std::string& key, double& l, double& w) {
+      std::vector<double> v;
+      k.get(key, v);
+      if (v.size() != 2 || !(v[0] > 0) || !(v[1] > 0))
+        throw ConfigError(k.file() + ": " + k.path() + "." + key + ": expected [length, width], both > 0");
+      l = v[0];
+      w = v[1];
+    };
+    readPrior("pedestrian_prior_size_m", cl.pedestrian_prior_length_m, cl.pedestrian_prior_width_m);
+    readPrior("cyclist_prior_size_m", cl.cyclist_prior_length_m, cl.cyclist_prior_width_m);
     cl.car = readWindow(k.section("car"));
     cl.van = readWindow(k.section("van"));
     cl.truck = readWindow(k.section("truck"));
@@ -90,6 +104,7 @@ DetectorConfig DetectorConfig::read(ConfigSection s) {
     cl.top_tan = std::tan(cl.top_tan * M_PI / 180.0);
     k.finish();
   }
+  c.scores = ScoreCalibration::read(s.section("score_calibration"));
   s.finish();
   try {
     c.validate();
@@ -119,6 +134,11 @@ void DetectorConfig::validate() const {
        "clustering.neighbour_columns: expected 1..8");
   need(clustering.distance_m > 0 && clustering.distance_per_m >= 0, "clustering.distance_m: expected > 0");
   need(clustering.min_points >= 1, "clustering.min_points: expected >= 1");
+  need(classes.cyclist_min_profile_step_m >= 0, "classes.cyclist_min_profile_step_m: expected >= 0");
+  need(classes.vehicle_min_height_drop_per_m >= 0 && classes.vehicle_min_height_drop_per_m < 0.05,
+       "classes.vehicle_min_height_drop_per_m: expected in [0, 0.05)");
+  need(classes.truck_min_face_m > 0 && classes.truck_prior_length_m > 0,
+       "classes.truck_min_face_m, truck_prior_length_m: expected > 0");
   need(classes.car_prior_length_m > 0 && classes.car_prior_width_m > 0, "classes.car_prior_size_m: expected > 0");
 }
 

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "detector/score_calibration.hpp"
 #include "dlslot/config.hpp"
 
 namespace dlslot::detector {
@@ -69,6 +70,22 @@ struct ClassConfig {
   double level_max_width_m = 1.5;  // ... when seen no wider than this (a wider L-shape is a corner)
   // A cluster whose quarters' tops differ by more than this is foliage, not a vehicle.
   double max_vehicle_profile_step_m = 1.3;
+  // A cyclist seen from the side has a rider above low wheels: its quarters' tops differ by at least
+  // this. A van's or a truck's back, as wide as a bicycle is long, is level (highway seeds 1-5: 11 of
+  // the Car group's misses were vans' backs taken for cyclists).
+  double cyclist_min_profile_step_m = 0.4;
+  // The lowest height of a (partly seen) vehicle drops by this per metre of range: far away the top
+  // beams are ~0.2 m apart at the roof and the ground under the vehicle is hidden by it, so the
+  // ground line climbs its lower body (highway seeds 1-5: cars at 25-40 m seen 0.6-1.0 m tall).
+  double vehicle_min_height_drop_per_m = 0.008;
+  // A truck's back: a face at least this wide (wider than cars and vans), completed to this length.
+  double truck_min_face_m = 2.3;
+  double truck_prior_length_m = 8.0;
+  // People and cyclists show their near half: their boxes grow away from the sensor to at least
+  // these footprints (length, width), as labels and learned detectors give them (a seen 0.47 x 0.32 m
+  // pedestrian against a 0.81 x 0.62 m label overlaps it by under the 0.25 3-D IoU the KITTI protocol asks).
+  double pedestrian_prior_length_m = 0.8, pedestrian_prior_width_m = 0.6;
+  double cyclist_prior_length_m = 1.7, cyclist_prior_width_m = 0.6;
   SizeWindow car{3.2, 5.4, 1.4, 2.2, 1.0, 1.9};
   SizeWindow van{4.2, 6.5, 1.7, 2.4, 1.9, 2.8};
   SizeWindow truck{6.0, 14.0, 2.0, 3.0, 2.5, 4.2};
@@ -88,6 +105,7 @@ struct DetectorConfig {
   GroundConfig ground;
   ClusteringConfig clustering;
   ClassConfig classes;
+  ScoreCalibration scores;
 
   // Throws ConfigError naming the file and the key.
   static DetectorConfig read(ConfigSection section);

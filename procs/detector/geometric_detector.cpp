@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+
+#include <Eigen/Geometry>
 
 #include "detector/ground_segmentation.hpp"
 #include "detector/object_class.hpp"
@@ -37,6 +40,30 @@ double profileStep(const PointCloud& scan, const std::vector<int>& members, cons
   for (float z : top)
     if (z > -1e8f) hi = std::max(hi, z), lo = std::min(lo, z);
   return hi > lo ? hi - lo : 0.0;
+}
+
+bool isVehicle(const std::string& type) { return type == "Car" || type == "Van" || type == "Truck"; }
+
+// A vehicle whose parts fell into two clusters (a far car's body below its cabin, a beam apart)
+// gives two boxes, one inside the other: the less confident one whose centre lies in a more
+// confident vehicle's footprint becomes Unknown (its points are still removed, it is not tracked).
+void demoteVehicleDuplicates(std::vector<Box>& boxes) {
+  std::vector<size_t> order;
+  for (size_t i = 0; i < boxes.size(); ++i)
+    if (isVehicle(boxes[i].type)) order.push_back(i);
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return boxes[a].score > boxes[b].score; });
+  for (size_t k = 1; k < order.size(); ++k) {
+    Box& d = boxes[order[k]];
+    for (size_t j = 0; j < k; ++j) {
+      const Box& o = boxes[order[j]];
+      if (!isVehicle(o.type)) continue;
+      const Eigen::Vector2d local = Eigen::Rotation2Dd(-o.yaw) * (d.center.head<2>() - o.center.head<2>());
+      if (std::abs(local.x()) <= 0.5 * o.size.x() && std::abs(local.y()) <= 0.5 * o.size.y()) {
+        d.type = kUnknownType;
+        break;
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -78,11 +105,15 @@ DetectionResult detectObjects(const PointCloud& scan, const DetectorConfig& cfg)
     // cluster that starts below the fitted ground stands in a dip).
     shape.ground_z = std::min(shape.ground_z, shape.min_z);
     if (std::optional<Box> box = classifyCluster(shape, cfg.classes)) {
+      box->score = cfg.scores.apply(box->type, box->score);  // on PointRCNN's scale (score_calibration.hpp)
       ++out.per_type[box->type];
       out.boxes.push_back(std::move(*box));
       out.shapes.push_back(shape);
     }
   }
+  demoteVehicleDuplicates(out.boxes);
+  out.per_type.clear();
+  for (const Box& b : out.boxes) ++out.per_type[b.type];
   out.timings.emplace_back("boxes", msSince(t));
   return out;
 }

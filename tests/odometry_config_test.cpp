@@ -18,6 +18,8 @@ TEST(OdometryConfig, ShippedSectionIsCompleteAndMatchesTheDefaults) {
   EXPECT_NO_THROW(s.finish());
   const OdometryConfig d;
   EXPECT_EQ(c.remove_detected_objects, d.remove_detected_objects);
+  EXPECT_DOUBLE_EQ(c.box_margin_m, d.box_margin_m);
+  EXPECT_DOUBLE_EQ(c.ground_clearance_m, d.ground_clearance_m);
   EXPECT_EQ(c.features.beam_model, d.features.beam_model);
   EXPECT_EQ(c.scan_to_scan.every_scan, d.scan_to_scan.every_scan);
   EXPECT_EQ(c.features.less_sharp_per_sector, d.features.less_sharp_per_sector);
@@ -56,6 +58,9 @@ TEST(OdometryConfig, ErrorsNameTheKey) {
   EXPECT_NE(errorOf(withReplaced("beam_model: hdl64", "beam_model: vlp16")).find("beam_model"), std::string::npos);
   EXPECT_NE(errorOf(withReplaced("min_range_m: 5.0", "min_range_mm: 5.0")).find("min_range_m"), std::string::npos);
   EXPECT_NE(errorOf(withReplaced("neighbors: 5", "neighbors: 2")).find("neighbors"), std::string::npos);
+  EXPECT_NE(errorOf(withReplaced("box_margin_m: 0.3", "box_margin_m: -0.3")).find("box_margin_m"), std::string::npos);
+  EXPECT_NE(errorOf(withReplaced("ground_clearance_m: 0.25", "ground_clearance_m: .nan")).find("ground_clearance_m"),
+            std::string::npos);
 }
 
 TEST(OdometryConfig, ModeNames) {

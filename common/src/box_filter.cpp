@@ -68,6 +68,28 @@ std::vector<bool> pointsInBoxes(const PointCloud& scan, const std::vector<Box>& 
   return inside;
 }
 
+Box removalVolume(const Box& detection, double margin, double ground_clearance) {
+  Box v = detection;
+  const double floor = detection.center.z() - 0.5 * detection.size.z();
+  const double bottom = floor + ground_clearance, top = floor + detection.size.z() + margin;
+  v.size.x() += 2.0 * margin;
+  v.size.y() += 2.0 * margin;
+  v.size.z() = std::max(0.0, top - bottom);
+  v.center.z() = v.size.z() > 0.0 ? 0.5 * (bottom + top) : top;
+  return v;
+}
+
+std::vector<bool> objectPoints(const PointCloud& scan, const std::vector<Box>& detections, double margin,
+                               double ground_clearance) {
+  std::vector<Box> volumes;
+  volumes.reserve(detections.size());
+  for (const Box& b : detections) {
+    const Box v = removalVolume(b, margin, ground_clearance);
+    if (v.size.z() > 0.0) volumes.push_back(v);
+  }
+  return pointsInBoxes(scan, volumes, 0.0);
+}
+
 PointCloud keepOutside(const PointCloud& scan, const std::vector<bool>& inside) {
   Eigen::Index n = 0;
   for (bool in : inside) n += in ? 0 : 1;

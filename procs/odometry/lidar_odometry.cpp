@@ -77,12 +77,13 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
     return out;
   };
 
-  // Features, after removing the points of potential dynamic objects (A-LOAM*, paper III-D).
+  // Features, after removing the points of potential dynamic objects (A-LOAM*, paper III-D), but
+  // not the ground they stand on (box_filter.hpp, removalVolume).
   auto t = Clock::now();
   double cpu = threadCpuMs();
   std::vector<bool> inside;
   if (out.detections_used && !frame.detections.empty()) {
-    inside = pointsInBoxes(frame.scan, frame.detections, cfg_.box_margin_m);
+    inside = objectPoints(frame.scan, frame.detections, cfg_.box_margin_m, cfg_.ground_clearance_m);
     for (bool in : inside) out.num_points_removed += in ? 1 : 0;
   }
   out.detail.emplace_back("box_removal", threadCpuMs() - cpu);

@@ -1,5 +1,6 @@
 #include "odometry_config.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace dlslot::odometry {
@@ -91,6 +92,9 @@ OdometryConfig readOdometryConfig(ConfigSection& s) {
     throw ConfigError(s.file() + ": " + s.path() + ".mode: " + e.what());
   }
   s.get("box_margin_m", c.box_margin_m);
+  s.get("ground_clearance_m", c.ground_clearance_m);
+  if (!(c.box_margin_m >= 0.0) || !std::isfinite(c.ground_clearance_m))
+    throw ConfigError(s.file() + ": " + s.path() + ": expected box_margin_m >= 0 and a finite ground_clearance_m");
   s.get("min_points", c.min_points);
   s.get("min_edge_features", c.min_edge_features);
   s.get("min_plane_features", c.min_plane_features);

@@ -83,7 +83,10 @@ struct OdometryConfig {
   ScanToMapConfig scan_to_map;
   // Paper III-D: A-LOAM* removes the points of detected objects before feature extraction.
   bool remove_detected_objects = true;
-  double box_margin_m = 0.3;          // boxes are grown by this on every side
+  double box_margin_m = 0.3;          // boxes are grown by this on every side but the bottom
+  // Points lower than this above a box's floor are ground and kept (box_filter.hpp,
+  // removalVolume); -box_margin_m removes the ground around the box as well.
+  double ground_clearance_m = 0.25;
   int min_points = 1000;              // fewer points after filtering: constant-velocity fallback
   int min_edge_features = 10;
   int min_plane_features = 50;

@@ -28,7 +28,8 @@ PointCounts drawPoints(cv::Mat& img, const RenderInput& in, const ViewTransform&
   std::vector<bool> removed;
   const bool filtered = !in.has_odometry || in.odometry_filtered;  // A-LOAM (unfiltered) removes nothing
   if (filtered && in.has_detections && !in.detections.empty())
-    removed = pointsInBoxes(in.scan, in.detections, cfg.removal_margin_m);  // the odometry's own test
+    removed = objectPoints(in.scan, in.detections, cfg.removal_margin_m,  // the odometry's own test
+                           cfg.removal_ground_clearance_m);
   for (bool r : removed) counts.removed += r;
   if (!cfg.layers.points && !cfg.layers.removed_points) return counts;
 

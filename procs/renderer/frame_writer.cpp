@@ -34,7 +34,8 @@ std::string FrameWriter::write(const RenderInput& in) {
     PointCloud sample(4, (in.scan.cols() + stride - 1) / stride);
     for (Eigen::Index i = 0, j = 0; i < in.scan.cols(); i += stride, ++j) sample.col(j) = in.scan.col(i);
     if (in.has_detections && !in.detections.empty())
-      sample = keepOutside(sample, pointsInBoxes(sample, in.detections, cfg_.view.removal_margin_m));
+      sample = keepOutside(sample, objectPoints(sample, in.detections, cfg_.view.removal_margin_m,
+                                                    cfg_.view.removal_ground_clearance_m));
     map_->add(sample, *in.ego_pose);
   }
   return path;

@@ -44,7 +44,11 @@ Layers layersFromNames(const std::vector<std::string>& names, const std::string&
 
 RendererConfig readRendererConfig(ConfigSection root) {
   RendererConfig c;
-  root.section("odometry").get("box_margin_m", c.view.removal_margin_m);
+  {
+    ConfigSection odometry = root.section("odometry");  // the odometry's own removal volume
+    odometry.get("box_margin_m", c.view.removal_margin_m);
+    odometry.get("ground_clearance_m", c.view.removal_ground_clearance_m);
+  }
   ConfigSection s = root.section("renderer");
   {
     ConfigSection v = s.section("view");

@@ -35,9 +35,11 @@ struct ViewConfig {
   double metres_per_pixel = 0.1;
   int width = 1000, height = 1000;
   Layers layers;
-  // Points within this distance of a detection count as removed: the odometry's box margin
-  // (odometry.box_margin_m), so the image shows exactly what A-LOAM* discarded.
+  // Points inside a detection's removal volume count as removed: the odometry's box margin and
+  // ground clearance (odometry.box_margin_m, ground_clearance_m), so the image shows exactly
+  // what A-LOAM* discarded.
   double removal_margin_m = 0.3;
+  double removal_ground_clearance_m = 0.25;
   double min_height_m = -2.5, max_height_m = 1.5;  // lidar z mapped to the ends of the colour ramp
   double velocity_arrow_s = 1.0;                   // an arrow shows where a track is after this long
 };

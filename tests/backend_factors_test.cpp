@@ -3,6 +3,7 @@
 // marginalization prior; and the Marginalizer's linearization against Ceres' own.
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <memory>
 #include <random>
@@ -578,4 +579,16 @@ TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
   EXPECT_NEAR(S(0, 0), 1.0 / c.odometry_sigma[0], 1e-12);
   EXPECT_EQ(parseMode("two-stage"), Mode::kTwoStage);
   EXPECT_THROW(parseMode("joint"), std::invalid_argument);
+  // A sigma list of the wrong length or with a non-positive entry names the key and the form.
+  for (const char* bad : {"[0.005, 0.005]", "[0.005, 0.0, 0.005]"}) {
+    YAML::Node node = YAML::LoadFile(std::string(DLSLOT_SOURCE_DIR) + "/config/dlslot.yaml")["backend"];
+    node["constant_acceleration_sigma"] = YAML::Load(bad);
+    ConfigSection edited(node, "cfg.yaml", "backend");
+    try {
+      BackendConfig::read(edited);
+      ADD_FAILURE() << bad;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("cfg.yaml: backend.constant_acceleration_sigma"), std::string::npos) << e.what();
+    }
+  }
 }

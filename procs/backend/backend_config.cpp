@@ -23,21 +23,25 @@ std::string toString(Mode mode) {
 
 namespace {
 
-Vector6 readSigmas(ConfigSection& s, const std::string& key) {
+// N standard deviations > 0 under `key`; `components` names them for the error message.
+template <int N>
+Eigen::Matrix<double, N, 1> readSigmas(ConfigSection& s, const std::string& key, const std::string& components) {
   std::vector<double> v;
   s.get(key, v);
-  if (v.size() != 6) {
-    throw ConfigError(s.file() + ": " + s.path() + "." + key + ": expected 6 standard deviations [tx ty tz rx ry rz], got " +
-                      std::to_string(v.size()) + " values");
+  if (static_cast<int>(v.size()) != N) {
+    throw ConfigError(s.file() + ": " + s.path() + "." + key + ": expected " + std::to_string(N) +
+                      " standard deviations [" + components + "], got " + std::to_string(v.size()) + " values");
   }
-  Vector6 out;
-  for (int i = 0; i < 6; ++i) {
+  Eigen::Matrix<double, N, 1> out;
+  for (int i = 0; i < N; ++i) {
     if (!(v[i] > 0.0))
       throw ConfigError(s.file() + ": " + s.path() + "." + key + ": standard deviations must be > 0");
     out[i] = v[i];
   }
   return out;
 }
+
+Vector6 readSigmas(ConfigSection& s, const std::string& key) { return readSigmas<6>(s, key, "tx ty tz rx ry rz"); }
 
 void require(bool ok, const ConfigSection& s, const std::string& key, const std::string& expected) {
   if (!ok) throw ConfigError(s.file() + ": " + s.path() + "." + key + ": expected " + expected);
@@ -61,24 +65,9 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   c.pose_change_sigma = readSigmas(s, "pose_change_sigma");
   c.constant_velocity_sigma = readSigmas(s, "constant_velocity_sigma");
   c.first_pose_sigma = readSigmas(s, "first_pose_sigma");
-  {
-    std::vector<double> v;
-    s.get("constant_acceleration_sigma", v);
-    if (v.size() != 3 || !(v[0] > 0 && v[1] > 0 && v[2] > 0))
-      throw ConfigError(s.file() + ": " + s.path() +
-                        ".constant_acceleration_sigma: expected 3 standard deviations > 0 [x m, y m, z m]");
-    c.constant_acceleration_sigma = Eigen::Vector3d(v[0], v[1], v[2]);
-  }
+  c.constant_acceleration_sigma = readSigmas<3>(s, "constant_acceleration_sigma", "x m, y m, z m");
   s.get("observation_sigma_growth_per_m", c.observation_sigma_growth_per_m);
-  {
-    std::vector<double> v;
-    s.get("vehicle_motion_sigma", v);
-    if (v.size() != 4 || !(v[0] > 0 && v[1] > 0 && v[2] > 0 && v[3] > 0))
-      throw ConfigError(s.file() + ": " + s.path() +
-                        ".vehicle_motion_sigma: expected 4 standard deviations > 0 [lateral m, vertical m, roll rad, "
-                        "pitch rad]");
-    c.vehicle_motion_sigma = Eigen::Vector4d(v[0], v[1], v[2], v[3]);
-  }
+  c.vehicle_motion_sigma = readSigmas<4>(s, "vehicle_motion_sigma", "lateral m, vertical m, roll rad, pitch rad");
   s.get("vehicle_types", c.vehicle_types);
   require(c.observation_sigma_growth_per_m >= 0.0, s, "observation_sigma_growth_per_m", "a number >= 0 (1/m)");
   s.get("degraded_odometry_scale", c.degraded_odometry_scale);

@@ -91,3 +91,16 @@ TEST(Config, TheDefaultConfigIsFoundFromAnyDirectory) {
   EXPECT_NE(errorOf([] { loadConfig("/nonexistent/dlslot.yaml"); }).find("/nonexistent/dlslot.yaml"), std::string::npos);
   fs::current_path(before);
 }
+
+// Found by fuzz_file_config: a key that is a map, a list or empty ("? a: b", "? [a]", "?") made
+// yaml-cpp throw its own exception out of the unknown-key check, past every ConfigError handler.
+TEST(Config, AKeyThatIsNotANameIsAConfigError) {
+  Channels channels;
+  for (const std::string& text : {std::string("? Every key: y\n"), std::string("? [a, b]\n: 1\n"),
+                                  std::string("channels: {}\n?\n: 1\n")}) {
+    const std::string path = writeYaml("cfg_key.yaml", text);
+    const std::string e = errorOf([&] { loadPipelineConfig(path, channels); });
+    EXPECT_NE(e.find(path), std::string::npos) << text << " -> " << e;
+    EXPECT_NE(e.find("expected a key name"), std::string::npos) << text << " -> " << e;
+  }
+}

@@ -17,6 +17,15 @@ template <> const char* typeName<std::string>() { return "a string"; }
 template <> const char* typeName<std::vector<double>>() { return "a list of numbers"; }
 template <> const char* typeName<std::vector<std::string>>() { return "a list of strings"; }
 
+// A map key as a name. YAML allows a list, a map or nothing as a key ("? [a]: 1", "? : 1"); no
+// section of ours has such keys, and yaml-cpp would throw its own exception converting one.
+std::string keyName(const YAML::Node& key, const std::string& file) {
+  if (!key.IsScalar())
+    throw ConfigError(file + " (line " + std::to_string(key.Mark().line + 1) + "): expected a key name, got " +
+                      (key.IsSequence() ? "a list" : key.IsMap() ? "a map" : "an empty key"));
+  return key.Scalar();
+}
+
 }  // namespace
 
 ConfigSection::ConfigSection(YAML::Node node, std::string file, std::string path)
@@ -71,7 +80,7 @@ ConfigSection ConfigSection::section(const std::string& key) {
 std::vector<std::string> ConfigSection::keys() const {
   std::vector<std::string> out;
   if (node_.IsMap())
-    for (const auto& kv : node_) out.push_back(kv.first.as<std::string>());
+    for (const auto& kv : node_) out.push_back(keyName(kv.first, file_));
   return out;
 }
 
@@ -80,7 +89,7 @@ void ConfigSection::skip(const std::string& key) { read_->insert(key); }
 void ConfigSection::finish() const {
   if (!node_.IsMap()) return;
   for (const auto& kv : node_) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = keyName(kv.first, file_);
     if (!read_->count(key))
       throw ConfigError(where(key) + " (line " + std::to_string(kv.first.Mark().line + 1) +
                         "): unknown key");

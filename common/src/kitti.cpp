@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "dlslot/input_error.hpp"
+#include "dlslot/kitti_stream.hpp"
 
 namespace fs = std::filesystem;
 
@@ -135,6 +136,10 @@ Pose Calib::T_rect_velo() const {
 
 Calib readCalib(const std::string& path) {
   std::ifstream in = openText(path);
+  return readCalib(in, path);
+}
+
+Calib readCalib(std::istream& in, const std::string& path) {
   Calib calib;
   bool have_velo_cam = false;
   std::string line;
@@ -197,13 +202,19 @@ PointCloud readVelodyne(const std::string& path) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw InputError(path, 0, "cannot open velodyne scan");
   const std::streamsize bytes = in.tellg();
+  std::vector<char> data(static_cast<size_t>(bytes));
+  in.seekg(0);
+  in.read(data.data(), bytes);
+  if (!in) throw InputError(path, 0, "short read");
+  return readVelodyne(data.data(), data.size(), path);
+}
+
+PointCloud readVelodyne(const char* data, size_t bytes, const std::string& path) {
   if (bytes % 16 != 0)
     throw InputError(path, 0, "size " + std::to_string(bytes) +
                                   " bytes is not a multiple of 16 (expected float32 x y z reflectance per point)");
-  PointCloud scan(4, bytes / 16);
-  in.seekg(0);
-  in.read(reinterpret_cast<char*>(scan.data()), bytes);
-  if (!in) throw InputError(path, 0, "short read");
+  PointCloud scan(4, static_cast<Eigen::Index>(bytes / 16));
+  if (bytes > 0) std::memcpy(scan.data(), data, bytes);
   if (!scan.allFinite()) {
     for (Eigen::Index i = 0; i < scan.cols(); ++i)
       if (!scan.col(i).allFinite())
@@ -244,6 +255,10 @@ CameraBox lidarToCamera(const Box& box, const Calib& calib) {
 
 std::vector<LabelRow> readTrackingLabels(const std::string& path) {
   std::ifstream in = openText(path);
+  return readTrackingLabels(in, path);
+}
+
+std::vector<LabelRow> readTrackingLabels(std::istream& in, const std::string& path) {
   std::vector<LabelRow> rows;
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {
@@ -365,6 +380,10 @@ std::optional<LabelRow> resultRow(int frame, const Box& box_lidar, const Calib& 
 
 std::vector<LabelRow> readCsvDetections(const std::string& path) {
   std::ifstream in = openText(path);
+  return readCsvDetections(in, path);
+}
+
+std::vector<LabelRow> readCsvDetections(std::istream& in, const std::string& path) {
   std::vector<LabelRow> rows;
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {
@@ -420,6 +439,10 @@ std::vector<FrameBoxes> boxesByFrame(const std::vector<LabelRow>& rows, const Ca
 
 std::vector<OxtsRecord> readOxts(const std::string& path) {
   std::ifstream in = openText(path);
+  return readOxts(in, path);
+}
+
+std::vector<OxtsRecord> readOxts(std::istream& in, const std::string& path) {
   std::vector<OxtsRecord> rows;
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {
@@ -498,6 +521,10 @@ std::vector<OxtsRecord> lidarPosesToOxts(const std::vector<Pose>& poses, const P
 
 std::vector<Pose> readPoses(const std::string& path) {
   std::ifstream in = openText(path);
+  return readPoses(in, path);
+}
+
+std::vector<Pose> readPoses(std::istream& in, const std::string& path) {
   std::vector<Pose> poses;
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {
@@ -529,6 +556,10 @@ void writePoses(const std::string& path, const std::vector<Pose>& poses) {
 
 std::vector<double> readTimes(const std::string& path) {
   std::ifstream in = openText(path);
+  return readTimes(in, path);
+}
+
+std::vector<double> readTimes(std::istream& in, const std::string& path) {
   std::vector<double> times;
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {

@@ -70,9 +70,9 @@ const Pose& needCalib(const std::optional<Pose>& T_cam_velo, const std::string& 
   return *T_cam_velo;
 }
 
-Trajectory readTum(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, 0, "cannot open for reading");
+}  // namespace
+
+Trajectory readTum(std::istream& in, const std::string& path) {
   Trajectory t;
   std::string line;
   for (int n = 1; std::getline(in, line); ++n) {
@@ -98,11 +98,13 @@ Trajectory readTum(const std::string& path) {
   return t;
 }
 
-}  // namespace
-
 Trajectory readTrajectory(const std::string& path, TrajectoryFormat format, const std::optional<Pose>& T_cam_velo,
                           double frame_period_s) {
-  if (format == TrajectoryFormat::Tum) return readTum(path);
+  if (format == TrajectoryFormat::Tum) {
+    std::ifstream in(path);
+    if (!in) throw InputError(path, 0, "cannot open for reading");
+    return readTum(in, path);
+  }
   std::vector<Pose> poses = kitti::readPoses(path);
   if (format == TrajectoryFormat::KittiCam) {
     const Pose& Tr = needCalib(T_cam_velo, path);

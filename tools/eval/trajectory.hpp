@@ -2,6 +2,7 @@
 // the same in the camera-0 frame (the KITTI odometry benchmark's convention), and TUM.
 #pragma once
 
+#include <istream>
 #include <optional>
 #include <string>
 #include <utility>
@@ -39,6 +40,8 @@ std::string formatName(TrajectoryFormat format);
 // kitti_cam needs T_cam_velo. Throws InputError naming the file and line.
 Trajectory readTrajectory(const std::string& path, TrajectoryFormat format,
                           const std::optional<Pose>& T_cam_velo = std::nullopt, double frame_period_s = 0.1);
+// The tum format from an open stream (readTrajectory opens the file); `path` names it in errors.
+Trajectory readTum(std::istream& in, const std::string& path);
 void writeTrajectory(const std::string& path, const Trajectory& trajectory, TrajectoryFormat format,
                      const std::optional<Pose>& T_cam_velo = std::nullopt);
 

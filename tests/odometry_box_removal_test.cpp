@@ -25,7 +25,21 @@ struct CarScene {
     detection.yaw = 0.02;
     detection.type = "Car";
   }
+  // The scan with its detection, as the odometry node hands it over.
+  Frame frame() const {
+    Frame f;
+    f.scan = scan;
+    f.detections = {detection};
+    return f;
+  }
 };
+
+// A-LOAM*: detected objects' points removed.
+OdometryConfig filteredConfig() {
+  OdometryConfig cfg;
+  cfg.remove_detected_objects = true;
+  return cfg;
+}
 
 int countInside(const PointCloud& scan, const Box& b, double margin) {
   int n = 0;
@@ -52,13 +66,9 @@ TEST(OdometryBoxRemoval, KeepsExactlyThePointsOutsideTheBoxes) {
 
 TEST(OdometryBoxRemoval, FilteredModeRemovesDetectedPointsBeforeFeatures) {
   const CarScene car;
-  OdometryConfig cfg;
-  cfg.remove_detected_objects = true;
+  const OdometryConfig cfg = filteredConfig();
   LidarOdometry odometry(cfg);
-  Frame frame;
-  frame.scan = car.scan;
-  frame.detections = {car.detection};
-  const OdometryResult r = odometry.process(frame, true);
+  const OdometryResult r = odometry.process(car.frame(), true);
   EXPECT_TRUE(r.detections_used);
   const Box volume = removalVolume(car.detection, cfg.box_margin_m, cfg.ground_clearance_m);
   EXPECT_EQ(r.num_points_removed, countInside(car.scan, volume, 0.0));
@@ -107,13 +117,9 @@ TEST(OdometryBoxRemoval, GroundAroundADetectedObjectStaysInTheMap) {
     ground_points += isGroundAroundCar(car.scan.col(i).head<3>().cast<double>());
   ASSERT_GT(ground_points, 50);  // the margin's ring around the car's footprint (152)
 
-  OdometryConfig cfg;
-  cfg.remove_detected_objects = true;
+  const OdometryConfig cfg = filteredConfig();
   LidarOdometry odometry(cfg);
-  Frame frame;
-  frame.scan = car.scan;
-  frame.detections = {car.detection};
-  const OdometryResult r = odometry.process(frame, true);
+  const OdometryResult r = odometry.process(car.frame(), true);
   const std::vector<bool> removed = objectPoints(car.scan, {car.detection}, cfg.box_margin_m, cfg.ground_clearance_m);
   int ground_removed = 0, body = 0, body_removed = 0;
   for (Eigen::Index i = 0; i < car.scan.cols(); ++i) {
@@ -136,7 +142,7 @@ TEST(OdometryBoxRemoval, GroundAroundADetectedObjectStaysInTheMap) {
   OdometryConfig old_cfg = cfg;
   old_cfg.ground_clearance_m = -old_cfg.box_margin_m;
   LidarOdometry old_odometry(old_cfg);
-  old_odometry.process(frame, true);
+  old_odometry.process(car.frame(), true);
   int old_in_map = 0;
   for (const Eigen::Vector3f& p : old_odometry.map().planes().points()) old_in_map += isGroundAroundCar(p.cast<double>());
   EXPECT_EQ(old_in_map, 0);
@@ -144,9 +150,7 @@ TEST(OdometryBoxRemoval, GroundAroundADetectedObjectStaysInTheMap) {
 
 TEST(OdometryBoxRemoval, ALoamModeAndMissingDetectionsKeepEverything) {
   const CarScene car;
-  Frame frame;
-  frame.scan = car.scan;
-  frame.detections = {car.detection};
+  const Frame frame = car.frame();
 
   OdometryConfig aloam;
   aloam.remove_detected_objects = false;

@@ -16,6 +16,8 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <optional>
+#include <set>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -173,6 +175,37 @@ std::vector<Msg> decodeAll(const std::vector<std::vector<uint8_t>>& raw) {
   for (const auto& r : raw) {
     Msg m;
     if (!decodeChecked(r.data(), r.size(), &m)) out.push_back(m);
+  }
+  return out;
+}
+
+// /proc/PID/stat's command, state and parent pid; nothing when the process is gone.
+struct ProcStat {
+  std::string comm;
+  char state = 0;
+  pid_t ppid = 0;
+};
+inline std::optional<ProcStat> procStat(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+  std::string text;
+  if (!std::getline(in, text)) return std::nullopt;
+  const auto open = text.find('('), close = text.rfind(')');
+  if (open == std::string::npos || close == std::string::npos) return std::nullopt;
+  ProcStat s;
+  s.comm = text.substr(open + 1, close - open - 1);
+  std::istringstream rest(text.substr(close + 2));
+  rest >> s.state >> s.ppid;
+  return s;
+}
+
+// The pids whose parent is `parent`.
+inline std::set<pid_t> childrenOf(pid_t parent) {
+  std::set<pid_t> out;
+  for (const auto& e : std::filesystem::directory_iterator("/proc")) {
+    const std::string name = e.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    const auto s = procStat(std::stoi(name));
+    if (s && s->ppid == parent) out.insert(std::stoi(name));
   }
   return out;
 }

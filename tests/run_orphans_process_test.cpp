@@ -5,8 +5,6 @@
 #include <signal.h>
 
 #include <filesystem>
-#include <fstream>
-#include <set>
 #include <thread>
 
 #include "process_harness.hpp"
@@ -16,35 +14,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The fields of /proc/PID/stat after the command: state and parent pid.
-bool procState(pid_t pid, char* state, pid_t* ppid) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
-  std::string text;
-  if (!std::getline(in, text)) return false;
-  const auto close = text.rfind(')');
-  if (close == std::string::npos) return false;
-  std::istringstream rest(text.substr(close + 2));
-  rest >> *state >> *ppid;
-  return true;
-}
-
-std::set<pid_t> childrenOf(pid_t parent) {
-  std::set<pid_t> out;
-  for (const auto& e : fs::directory_iterator("/proc")) {
-    const std::string name = e.path().filename().string();
-    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
-    char state = 0;
-    pid_t ppid = 0;
-    if (procState(std::stoi(name), &state, &ppid) && ppid == parent) out.insert(std::stoi(name));
-  }
-  return out;
-}
-
 // Running (not gone, not a zombie waiting to be reaped).
 bool alive(pid_t pid) {
-  char state = 0;
-  pid_t ppid = 0;
-  return procState(pid, &state, &ppid) && state != 'Z' && state != 'X';
+  const auto s = procStat(pid);
+  return s && s->state != 'Z' && s->state != 'X';
 }
 
 }  // namespace
@@ -77,10 +50,8 @@ TEST(RunOrphansProcess, SigkillOfTheLauncherLeavesNoChildRunning) {
   }
   std::string names;
   for (pid_t p : left) {
-    std::ifstream comm("/proc/" + std::to_string(p) + "/comm");
-    std::string n;
-    comm >> n;
-    names += " " + n + "(" + std::to_string(p) + ")";
+    const auto s = procStat(p);
+    names += " " + (s ? s->comm : std::string("?")) + "(" + std::to_string(p) + ")";
     kill(p, SIGKILL);  // do not leave them to the next test
   }
   EXPECT_TRUE(left.empty()) << left.size() << " of " << children.size() << " children survived the launcher:" << names;

@@ -6,7 +6,6 @@
 #include <signal.h>
 
 #include <filesystem>
-#include <fstream>
 #include <thread>
 
 #include "process_harness.hpp"
@@ -18,19 +17,9 @@ namespace {
 
 // The pid of the child of `parent` running `comm`, or -1.
 pid_t childNamed(pid_t parent, const std::string& comm) {
-  for (const auto& e : fs::directory_iterator("/proc")) {
-    const std::string name = e.path().filename().string();
-    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
-    std::ifstream stat(e.path() / "stat");
-    std::string text;
-    if (!std::getline(stat, text)) continue;
-    const auto open = text.find('('), close = text.rfind(')');
-    if (open == std::string::npos || close == std::string::npos) continue;
-    std::istringstream rest(text.substr(close + 2));
-    char state = 0;
-    pid_t ppid = 0;
-    rest >> state >> ppid;
-    if (ppid == parent && text.substr(open + 1, close - open - 1) == comm) return std::stoi(name);
+  for (pid_t pid : childrenOf(parent)) {
+    const auto s = procStat(pid);
+    if (s && s->comm == comm) return pid;
   }
   return -1;
 }

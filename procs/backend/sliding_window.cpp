@@ -370,8 +370,9 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
         // The linear velocity from the chain (eq. 10-11 and the constant-acceleration factor smooth
         // it) once the chain spans the window: from then on the marginalization prior carries its
         // history beyond the window. A younger chain's pose changes are worse than a line through
-        // the window's boxes (highway, highway-jam, intersection seed 1: velocity RMSE
-        // 0.49 / 0.54 / 0.50 reading the chain from 2 changes on, 0.44 / 0.47 / 0.43 from 9 on).
+        // the window's boxes (tuning runs highway, highway-jam, intersection seed 1, velocity RMSE
+        // 0.49 / 0.54 / 0.50 reading the chain from 2 changes on, 0.44 / 0.47 / 0.43 from 9 on;
+        // measured with the acceleration factors marginalized, before they were dropped).
         const auto last = track.poses.rbegin();
         auto first = last;
         for (int i = 0; i < config_.velocity_frames && std::next(first) != track.poses.rend(); ++i) ++first;

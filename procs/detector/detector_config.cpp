@@ -18,6 +18,16 @@ void readRange(ConfigSection& s, const std::string& key, double& lo, double& hi)
   hi = v[1];
 }
 
+// [length, width] of a prior box size, both > 0.
+void readSize(ConfigSection& s, const std::string& key, double& length, double& width) {
+  std::vector<double> v;
+  s.get(key, v);
+  if (v.size() != 2 || !(v[0] > 0) || !(v[1] > 0))
+    throw ConfigError(s.file() + ": " + s.path() + "." + key + ": expected [length, width], both > 0");
+  length = v[0];
+  width = v[1];
+}
+
 SizeWindow readWindow(ConfigSection s) {
   SizeWindow w;
   readRange(s, "length_m", w.min_length_m, w.max_length_m);
@@ -60,11 +70,7 @@ DetectorConfig DetectorConfig::read(ConfigSection s) {
   {
     ConfigSection k = s.section("classes");
     ClassConfig& cl = c.classes;
-    std::vector<double> prior;
-    k.get("car_prior_size_m", prior);
-    if (prior.size() != 2) throw ConfigError(k.file() + ": " + k.path() + ".car_prior_size_m: expected [length, width]");
-    cl.car_prior_length_m = prior[0];
-    cl.car_prior_width_m = prior[1];
+    readSize(k, "car_prior_size_m", cl.car_prior_length_m, cl.car_prior_width_m);
     k.get("car_side_min_m", cl.car_side_min_m);
     k.get("min_corner_edge_fraction", cl.min_corner_edge_fraction);
     k.get("min_side_edge_fraction", cl.min_side_edge_fraction);
@@ -76,16 +82,8 @@ DetectorConfig DetectorConfig::read(ConfigSection s) {
     k.get("vehicle_min_height_drop_per_m", cl.vehicle_min_height_drop_per_m);
     k.get("truck_min_face_m", cl.truck_min_face_m);
     k.get("truck_prior_length_m", cl.truck_prior_length_m);
-    auto readPrior = [&](const std::string& key, double& l, double& w) {
-      std::vector<double> v;
-      k.get(key, v);
-      if (v.size() != 2 || !(v[0] > 0) || !(v[1] > 0))
-        throw ConfigError(k.file() + ": " + k.path() + "." + key + ": expected [length, width], both > 0");
-      l = v[0];
-      w = v[1];
-    };
-    readPrior("pedestrian_prior_size_m", cl.pedestrian_prior_length_m, cl.pedestrian_prior_width_m);
-    readPrior("cyclist_prior_size_m", cl.cyclist_prior_length_m, cl.cyclist_prior_width_m);
+    readSize(k, "pedestrian_prior_size_m", cl.pedestrian_prior_length_m, cl.pedestrian_prior_width_m);
+    readSize(k, "cyclist_prior_size_m", cl.cyclist_prior_length_m, cl.cyclist_prior_width_m);
     cl.car = readWindow(k.section("car"));
     cl.van = readWindow(k.section("van"));
     cl.truck = readWindow(k.section("truck"));
@@ -94,12 +92,7 @@ DetectorConfig DetectorConfig::read(ConfigSection s) {
     k.get("pole_max_width_m", cl.pole_max_width_m);
     k.get("max_bottom_m", cl.max_bottom_m);
     k.get("unknown_max_length_m", cl.unknown_max_length_m);
-    std::vector<double> h;
-    k.get("unknown_height_m", h);
-    if (h.size() != 2 || !(h[1] >= h[0]))
-      throw ConfigError(k.file() + ": " + k.path() + ".unknown_height_m: expected [min, max]");
-    cl.unknown_min_height_m = h[0];
-    cl.unknown_max_height_m = h[1];
+    readRange(k, "unknown_height_m", cl.unknown_min_height_m, cl.unknown_max_height_m);
     k.get("top_beam_deg", cl.top_tan);
     cl.top_tan = std::tan(cl.top_tan * M_PI / 180.0);
     k.finish();

@@ -1,5 +1,6 @@
 // The geometric detector on ray-cast scenes with known boxes: flat ground, a slope, a kerb, a row
-// of parked cars, a pedestrian next to a pole; and bad input (empty scan, NaN points).
+// of parked cars, a pedestrian next to a pole, a truck beside the ego, a van seen over a car; and
+// bad input (empty scan, NaN points).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -158,6 +159,40 @@ TEST(DetectorScenes, WallAndPoleAloneGiveNoObjects) {
   SCOPED_TRACE("detections:\n" + describe(r));
   for (const Box& d : r.boxes) EXPECT_EQ(d.type, kUnknownType) << "at " << d.center.transpose();
   EXPECT_EQ(r.boxes.size(), 0u);
+}
+
+TEST(DetectorScenes, TruckBesideTheEgoIsOneTruck) {
+  // A 10 m truck in the next lane, level with the ego: the top beam cuts its side at ~1.85 m, and
+  // the points nearer than min_range_m (the ego's own body) cut the side in two pieces.
+  DetectorScene scene;
+  const Box truck = scene.place("Truck", 1.0, -3.5, 0.0, 10.0, 2.5, 3.2);
+  const DetectionResult r = detectObjects(scene.scan(), DetectorConfig{});
+  SCOPED_TRACE("detections:\n" + describe(r));
+  const Box* d = nearest(r.boxes, truck, 1.0);
+  ASSERT_NE(d, nullptr);
+  EXPECT_EQ(d->type, "Truck");
+  EXPECT_NEAR(d->size.x(), 10.0, 0.5);
+  EXPECT_LT(axisError(d->yaw, 0.0), 3.0 * M_PI / 180);
+  EXPECT_GE(d->size.z(), 2.5) << "at least a truck's height, not the 1.85 m the top beam saw";
+  EXPECT_EQ(r.boxes.size(), 1u) << "not split in two";
+}
+
+TEST(DetectorScenes, VanSeenOverACarIsAVehicleAndASignIsNot) {
+  // A van queueing 3 m behind a car ahead shows only its top above the car: it seems to hang in
+  // the air, but its bottom is hidden by the car, not raised. A sign 2.5 m up beyond it is not hidden.
+  DetectorScene scene;
+  scene.car(15.0, 0.0, 0.0, 4.2, 1.75, 1.5);
+  const Box van = scene.place("Van", 22.5, 0.0, 0.0, 5.0, 1.95, 2.3);
+  Box& sign = scene.place("Sign", 32.0, 0.0, 0.0, 0.3, 2.0, 1.0);
+  sign.center.z() += 2.5;
+  const Box sign_box = sign;
+  const DetectionResult r = detectObjects(scene.scan(), DetectorConfig{});
+  SCOPED_TRACE("detections:\n" + describe(r));
+  const Box* d = nearest(r.boxes, van, 1.0);
+  ASSERT_NE(d, nullptr);
+  EXPECT_TRUE(isVehicle(d->type)) << d->type;
+  EXPECT_NEAR(d->center.z() - 0.5 * d->size.z(), van.center.z() - 0.5 * van.size.z(), 0.2) << "standing on the ground";
+  EXPECT_EQ(nearest(r.boxes, sign_box, 2.0), nullptr) << "the sign is an overhang";
 }
 
 TEST(DetectorBadInput, EmptyScanGivesNoBoxes) {

@@ -104,6 +104,20 @@ std::optional<Box> truckBack(const ClusterShape& s, bool cut_at_top, const Class
   return makeBox(full, s, "Truck", logit(confidence(s.num_points, 60, seen.edge_fraction, depth / full.length)));
 }
 
+// A truck's or a bus's side right beside the ego (intersection seed 8: a 10 m truck in the next lane
+// for 53 of 60 frames): cut by the top beam, thin, as long as a truck. Nothing else completes a
+// stretch that long; its back and front stay hidden. Grown away from the sensor to a truck's width
+// and height (the top beam saw only its lower 2 m).
+std::optional<Box> truckSide(ClusterShape s, bool cut_beside, const ClassConfig& cfg) {
+  const Rectangle& seen = s.seen;
+  if (!cut_beside || seen.width >= kFaceMaxDepth_m || seen.edge_fraction < kTruckBackEdgeFraction) return std::nullopt;
+  if (seen.length < cfg.truck.min_length_m || seen.length > cfg.truck.max_length_m) return std::nullopt;
+  const double width = 0.5 * (cfg.truck.min_width_m + cfg.truck.max_width_m);
+  const Rectangle full = completeVehicle(seen, seen.length, width, 0.0);
+  s.max_z = std::max(s.max_z, s.ground_z + cfg.truck.min_height_m);
+  return makeBox(full, s, "Truck", logit(confidence(s.num_points, 60, seen.edge_fraction, 0.5)));
+}
+
 }  // namespace
 
 std::optional<Box> classifyCluster(const ClusterShape& s_in, const ClassConfig& cfg) {
@@ -129,6 +143,7 @@ std::optional<Box> classifyCluster(const ClusterShape& s_in, const ClassConfig& 
   // 28-38 m ahead): a face wider than any car or van, across the line of sight, tall or cut by the
   // top beam, seen less deep than a truck is long. Completed away from the sensor to the truck prior.
   if (std::optional<Box> back = truckBack(s, cut_at_top, cfg)) return back;
+  if (std::optional<Box> side = truckSide(s, cut_beside, cfg)) return side;
   const bool level_side = seen.length >= cfg.car_side_min_m && seen.width < cfg.level_max_width_m && !cut_beside &&
                           s.profile_step < cfg.min_profile_step_m;
   if (level_side) return std::nullopt;

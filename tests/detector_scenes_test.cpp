@@ -1,6 +1,6 @@
 // The geometric detector on ray-cast scenes with known boxes: flat ground, a slope, a kerb, a row
-// of parked cars, a pedestrian next to a pole, a truck beside the ego, a van seen over a car; and
-// bad input (empty scan, NaN points).
+// of parked cars, a pedestrian next to a pole, a truck beside the ego, a van seen over a car, a
+// person seen over a parked car; and bad input (empty scan, NaN points).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -193,6 +193,22 @@ TEST(DetectorScenes, VanSeenOverACarIsAVehicleAndASignIsNot) {
   EXPECT_TRUE(isVehicle(d->type)) << d->type;
   EXPECT_NEAR(d->center.z() - 0.5 * d->size.z(), van.center.z() - 0.5 * van.size.z(), 0.2) << "standing on the ground";
   EXPECT_EQ(nearest(r.boxes, sign_box, 2.0), nullptr) << "the sign is an overhang";
+}
+
+TEST(DetectorScenes, GroundDoesNotClimbAPersonSeenOverAParkedCar) {
+  // A parked car hides the pavement behind it for tens of metres; of a person standing there only
+  // the top half shows over its roof. The ground line must not climb onto that half across the
+  // hidden stretch (the slope allowed over a gap is capped: kMaxClimbRun_m), or the person becomes
+  // a sliver too short to be one.
+  DetectorScene scene;
+  scene.car(12.5, -4.6, 0.0, 4.2, 1.75, 1.3);
+  const Box person = scene.place("Pedestrian", 20.5, -6.5, 0.0, 0.6, 0.5, 1.75);
+  const DetectionResult r = detectObjects(scene.scan(), DetectorConfig{});
+  SCOPED_TRACE("detections:\n" + describe(r));
+  const Box* p = nearest(r.boxes, person, 0.6);
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(p->type, "Pedestrian");
+  EXPECT_NEAR(p->size.z(), 1.75, 0.2) << "standing on the road, not on the ground line's climb";
 }
 
 TEST(DetectorBadInput, EmptyScanGivesNoBoxes) {

@@ -2,7 +2,8 @@
 // line walking outwards over range bins (after Himmelsbach et al., "Fast segmentation of 3D point
 // clouds for ground vehicles", IV 2010), not as one plane for the whole scan. A bin's lowest point
 // continues the ground when it lies within max_step_m + max_slope x run of the ground behind it
-// (a kerb is a step, a hill a slope); a bin whose lowest point is higher (a car's body, a wall)
+// (a kerb is a step, a hill a slope; the run counted up to 4 m, so the line does not climb onto
+// what stands in a parked car's shadow); a bin whose lowest point is higher (a car's body, a wall)
 // gets the ground continued from behind it along the sector's slope.
 #pragma once
 

@@ -426,6 +426,18 @@ TEST_F(EvalLog, TruncatedCorruptEmptyAndMissingLogsAreClearErrors) {
   EXPECT_NE(r.err.find(path("garbage.lcmlog") + ": "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("corrupt log"), std::string::npos) << r.err;
 
+  // A header that claims more data than the file holds: refused before LCM allocates it (with
+  // 0x7fffffff, LCM 1.3.1's size + 1 overflowed and dlslot-eval died of SIGSEGV; lcm_log.hpp).
+  for (const uint32_t claimed : {0x7fffffffu, 0x40000000u}) {
+    std::string bytes = slurp(path("run.lcmlog"));
+    for (int k = 0; k < 4; ++k) bytes[24 + k] = static_cast<char>((claimed >> (24 - 8 * k)) & 0xff);
+    std::ofstream(path("claims.lcmlog"), std::ios::binary) << bytes;
+    r = eval("--log " + path("claims.lcmlog"));
+    EXPECT_EQ(r.code, 1) << claimed;
+    EXPECT_NE(r.err.find(path("claims.lcmlog") + ": truncated or corrupt log: the event at offset 0 claims"),
+              std::string::npos) << r.err;
+  }
+
   // A message that does not decode as the channel's type: skipped, counted and named (issue 17:
   // one bad message no longer makes a recorded run unreadable); nothing else here, so no truth.
   {

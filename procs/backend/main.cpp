@@ -12,6 +12,7 @@
 #include "backend/backend_messages.hpp"
 #include "backend/heap_memory.hpp"
 #include "dlslot/frame_joiner.hpp"
+#include "dlslot/lcm_log.hpp"
 #include "backend/sliding_window.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/timing_stats.hpp"
@@ -82,7 +83,7 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
     else accepted[index] = msg->frame;
     return !why;
   };
-  for (; const lcm::LogEvent* ev = in.readNextEvent(); ++index) {
+  for (; const lcm::LogEvent* ev = nextLogEvent(in, in_path); ++index) {
     if (ev->channel == channels.odometry) {
       odometry_t m;
       if (decode(*ev, &m)) joiner.addA(m.frame, OdometryPart{m.utime, fromMsg(m)}, 0.0);
@@ -126,7 +127,7 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
       copy.eventnum = n++;
       if (out.writeEvent(&copy) != 0) throw std::runtime_error(out_path + ": write failed");
     };
-    for (int64_t i = 0; const lcm::LogEvent* ev = again.readNextEvent(); ++i) {
+    for (int64_t i = 0; const lcm::LogEvent* ev = nextLogEvent(again, in_path); ++i) {
       if (ev->channel == channels.slot_state) continue;
       write(*ev);
       const auto input = accepted.find(i);

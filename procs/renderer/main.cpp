@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "dlslot/input_error.hpp"
+#include "dlslot/lcm_log.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/progress.hpp"
 #include "frame_queue.hpp"
@@ -75,7 +76,7 @@ int renderLog(const std::string& log_path, const std::string& out, const Rendere
     // A first pass counts the scans so progress can show an ETA.
     lcm::LogFile log(log_path, "r");
     if (!log.good()) throw InputError(log_path, 0, "cannot open as an LCM log");
-    while (const lcm::LogEvent* e = log.readNextEvent()) scans += e->channel == channels.scan;
+    while (const lcm::LogEvent* e = nextLogEvent(log, log_path)) scans += e->channel == channels.scan;
   }
   lcm::LogFile log(log_path, "r");
   if (!log.good()) throw InputError(log_path, 0, "cannot open as an LCM log");
@@ -85,7 +86,7 @@ int renderLog(const std::string& log_path, const std::string& out, const Rendere
   FrameWriter writer(out, cfg);
   FrameSink sink(writer, status, false);
   ProgressLine progress("render", scans);
-  while (const lcm::LogEvent* e = log.readNextEvent()) {
+  while (const lcm::LogEvent* e = nextLogEvent(log, log_path)) {
     feed.handle(e->channel, e->data, e->datalen);
     sink.draw(state.takeReady());
     progress.update(sink.written());

@@ -14,6 +14,7 @@
 #include "dlslot/frame_accounting.hpp"
 #include "dlslot/ground_truth_t.hpp"
 #include "dlslot/input_error.hpp"
+#include "dlslot/lcm_log.hpp"
 #include "dlslot/message_guard.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/odometry_t.hpp"
@@ -21,8 +22,6 @@
 
 namespace dlslot::eval {
 namespace {
-
-constexpr int64_t kEventHeaderBytes = 4 + 8 + 8 + 4 + 4;  // sync word, event number, timestamp, two lengths
 
 double seconds(int64_t utime) { return utime * 1e-6; }
 
@@ -70,14 +69,10 @@ class LogReader {
                                  &ch_.slot_state})
       run_.frame_counts[*c] = 0;
     int64_t end_of_last = 0, count = 0;
-    while (const lcm::LogEvent* ev = log.readNextEvent()) {
-      // Newer LCM versions skip garbage silently; an event must start where the previous one ended.
-      const int64_t end = std::ftell(log.getFilePtr());
-      const int64_t start = end - kEventHeaderBytes - static_cast<int64_t>(ev->channel.size()) - ev->datalen;
-      if (start != end_of_last)
-        throw InputError(path_, 0, "corrupt log: " + std::to_string(start - end_of_last) + " unreadable bytes at offset " +
-                                       std::to_string(end_of_last) + " (before event " + std::to_string(count) + ")");
-      end_of_last = end;
+    // nextLogEvent checks each header against the file before LCM allocates (lcm_log.hpp) and
+    // refuses garbage between events, so every event starts where the previous one ended.
+    while (const lcm::LogEvent* ev = nextLogEvent(log, path_)) {
+      end_of_last = std::ftell(log.getFilePtr());
       handle(*ev, count++);
     }
     if (end_of_last != static_cast<int64_t>(file_size))

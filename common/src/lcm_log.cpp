@@ -1,0 +1,48 @@
+#include "dlslot/lcm_log.hpp"
+
+#include <sys/stat.h>
+
+#include <cstdint>
+#include <cstdio>
+
+#include "dlslot/input_error.hpp"
+
+namespace dlslot {
+namespace {
+
+// An event: sync word, event number, timestamp, channel length, data length (big-endian), then
+// the channel name and the data.
+constexpr int64_t kHeaderBytes = 4 + 8 + 8 + 4 + 4;
+constexpr uint32_t kSync = 0xEDA1DA01u;
+constexpr int32_t kMaxChannelLength = 1000;  // LCM's own limit
+
+uint32_t bigEndian32(const unsigned char* p) {
+  return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) | (uint32_t{p[2]} << 8) | uint32_t{p[3]};
+}
+
+}  // namespace
+
+const lcm::LogEvent* nextLogEvent(lcm::LogFile& log, const std::string& path) {
+  std::FILE* f = log.getFilePtr();
+  struct stat st {};
+  const long at = f ? std::ftell(f) : -1;
+  if (at < 0 || fstat(fileno(f), &st) != 0) throw InputError(path, 0, "cannot read the log");
+  const int64_t left = static_cast<int64_t>(st.st_size) - at;
+  if (left <= 0) return nullptr;
+  const std::string where = " at offset " + std::to_string(at);
+  unsigned char h[kHeaderBytes];
+  if (left < kHeaderBytes || std::fread(h, 1, kHeaderBytes, f) != static_cast<size_t>(kHeaderBytes))
+    throw InputError(path, 0, "truncated or corrupt log: " + std::to_string(left) + " bytes" + where +
+                                  " do not hold an event header (" + std::to_string(kHeaderBytes) + " bytes)");
+  if (std::fseek(f, at, SEEK_SET) != 0) throw InputError(path, 0, "cannot read the log");
+  if (bigEndian32(h) != kSync) throw InputError(path, 0, "corrupt log: no event starts" + where);
+  const int32_t channel = static_cast<int32_t>(bigEndian32(h + 20)), data = static_cast<int32_t>(bigEndian32(h + 24));
+  if (channel <= 0 || channel >= kMaxChannelLength || data < 0 ||
+      int64_t{channel} + data > left - kHeaderBytes)
+    throw InputError(path, 0, "truncated or corrupt log: the event" + where + " claims a " + std::to_string(channel) +
+                                  "-byte channel and " + std::to_string(data) + " data bytes, " +
+                                  std::to_string(left - kHeaderBytes) + " bytes remain");
+  return log.readNextEvent();
+}
+
+}  // namespace dlslot

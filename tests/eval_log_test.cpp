@@ -460,6 +460,11 @@ TEST_F(EvalLog, TruncatedCorruptEmptyAndMissingLogsAreClearErrors) {
   r = eval("--log " + path("missing.lcmlog"));
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find(path("missing.lcmlog")), std::string::npos) << r.err;
+
+  fs::create_directories(path("directory.lcmlog"));
+  r = eval("--log " + path("directory.lcmlog"));
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find(path("directory.lcmlog") + ": is not a file"), std::string::npos) << r.err;
 }
 
 TEST_F(EvalLog, ResultFilesOfDifferentLengthsOrWithoutGroundTruthAreRejected) {

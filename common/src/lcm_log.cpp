@@ -27,6 +27,7 @@ const lcm::LogEvent* nextLogEvent(lcm::LogFile& log, const std::string& path) {
   struct stat st {};
   const long at = f ? std::ftell(f) : -1;
   if (at < 0 || fstat(fileno(f), &st) != 0) throw InputError(path, 0, "cannot read the log");
+  if (!S_ISREG(st.st_mode)) throw InputError(path, 0, "is not a file (expected an LCM log)");
   const int64_t left = static_cast<int64_t>(st.st_size) - at;
   if (left <= 0) return nullptr;
   const std::string where = " at offset " + std::to_string(at);
@@ -42,7 +43,11 @@ const lcm::LogEvent* nextLogEvent(lcm::LogFile& log, const std::string& path) {
     throw InputError(path, 0, "truncated or corrupt log: the event" + where + " claims a " + std::to_string(channel) +
                                   "-byte channel and " + std::to_string(data) + " data bytes, " +
                                   std::to_string(left - kHeaderBytes) + " bytes remain");
-  return log.readNextEvent();
+  // The header fits the file, so LCM reads the whole event; it then also checks that a sync word
+  // follows ("Invalid header after log data") and gives nothing when garbage does.
+  const lcm::LogEvent* event = log.readNextEvent();
+  if (!event) throw InputError(path, 0, "corrupt log: no event follows the one" + where);
+  return event;
 }
 
 }  // namespace dlslot

@@ -66,32 +66,30 @@ void demoteVehicleDuplicates(std::vector<Box>& boxes) {
   }
 }
 
-// Where a cluster lies in the range image: its columns (an interval that may wrap past the last
-// column), its lowest and highest elevation (tan), its nearest and farthest range, its top (z).
+// Where a cluster lies in the range image: its columns (an interval that may pass the last
+// column: a cluster behind the sensor wraps), its lowest and highest elevation (tan), its nearest
+// and farthest range, its top (z).
 struct Silhouette {
-  int col_lo = 1 << 30, col_hi = -1;
+  int col_lo = 0, col_hi = -1;
   float min_tan = 1e9f, max_tan = -1e9f, near = 1e9f, far = 0.0f, top_z = -1e9f;
-  std::vector<int> columns;
 
-  void add(int column, float z, float range) {
-    columns.push_back(column);
+  void add(int column, int columns, float z, float range) {
+    // Two candidate intervals, of the columns and of the columns turned half a circle; the
+    // narrower one is the cluster's (an object spans far less than half a turn).
+    lo_ = std::min(lo_, column), hi_ = std::max(hi_, column);
+    const int turned = (column + columns / 2) % columns;
+    turned_lo_ = std::min(turned_lo_, turned), turned_hi_ = std::max(turned_hi_, turned);
     min_tan = std::min(min_tan, z / range), max_tan = std::max(max_tan, z / range);
     near = std::min(near, range), far = std::max(far, range);
     top_z = std::max(top_z, z);
   }
-  // The smallest interval [col_lo, col_hi] (col_hi may pass `n`: the interval wraps) holding every column.
-  void close(int n) {
-    std::sort(columns.begin(), columns.end());
-    columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
-    if (columns.empty()) return;
-    // The widest gap between neighbouring columns (circularly) is the part of the circle outside.
-    int gap = columns.front() + n - columns.back(), start = columns.front();
-    for (size_t i = 1; i < columns.size(); ++i)
-      if (columns[i] - columns[i - 1] > gap) gap = columns[i] - columns[i - 1], start = columns[i];
-    col_lo = start;
-    col_hi = start + n - gap;
-    columns.clear();
-    columns.shrink_to_fit();
+  void close(int columns) {
+    if (hi_ - lo_ <= turned_hi_ - turned_lo_) {
+      col_lo = lo_, col_hi = hi_;
+    } else {
+      col_lo = turned_lo_ - columns / 2, col_hi = turned_hi_ - columns / 2;
+      if (col_lo < 0) col_lo += columns, col_hi += columns;
+    }
   }
   // Columns of [lo, hi] (wrapping like this interval) this interval shares.
   int overlap(const Silhouette& o, int n) const {
@@ -100,6 +98,9 @@ struct Silhouette {
       best = std::max(best, std::min(col_hi, o.col_hi + shift) - std::max(col_lo, o.col_lo + shift) + 1);
     return best;
   }
+
+ private:
+  int lo_ = 1 << 30, hi_ = -1, turned_lo_ = 1 << 30, turned_hi_ = -1;
 };
 
 // One cluster as the classifier and the occlusion test see it.
@@ -139,7 +140,7 @@ Measured measureCluster(const PointCloud& scan, const ScanLayout& layout, const 
     shape.min_z = std::min<double>(shape.min_z, z);
     shape.max_z = std::max<double>(shape.max_z, z);
     shape.max_tan = std::max<double>(shape.max_tan, z / layout.range[i]);
-    out.silhouette.add(layout.column[i], z, layout.range[i]);
+    out.silhouette.add(layout.column[i], layout.columns, z, layout.range[i]);
     xy.emplace_back(scan(0, i), scan(1, i));
   }
   out.silhouette.close(layout.columns);

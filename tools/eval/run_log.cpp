@@ -2,9 +2,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
-#include <cstdio>
 #include <algorithm>
-#include <filesystem>
 #include <optional>
 #include <type_traits>
 
@@ -60,25 +58,15 @@ class LogReader {
       : path_(path), ch_(channels), track_max_unseen_(track_max_unseen) {}
 
   RunLog read() {
-    std::error_code ec;
-    const auto file_size = std::filesystem::file_size(path_, ec);
-    if (ec) throw InputError(path_, 0, "cannot read the log: " + ec.message());
     lcm::LogFile log(path_, "r");
     if (!log.good()) throw InputError(path_, 0, "cannot open the log for reading");
     for (const std::string* c : {&ch_.scan, &ch_.detections, &ch_.ground_truth, &ch_.odometry, &ch_.associations,
                                  &ch_.slot_state})
       run_.frame_counts[*c] = 0;
-    int64_t end_of_last = 0, count = 0;
-    // nextLogEvent checks each header against the file before LCM allocates (lcm_log.hpp) and
-    // refuses garbage between events, so every event starts where the previous one ended.
-    while (const lcm::LogEvent* ev = nextLogEvent(log, path_)) {
-      end_of_last = std::ftell(log.getFilePtr());
-      handle(*ev, count++);
-    }
-    if (end_of_last != static_cast<int64_t>(file_size))
-      throw InputError(path_, 0, "truncated or corrupt log: the bytes from offset " + std::to_string(end_of_last) +
-                                     " to " + std::to_string(file_size) + " (after " + std::to_string(count) +
-                                     " complete events) do not form a complete event");
+    // nextLogEvent (lcm_log.hpp) refuses truncated and corrupt logs, garbage between events and
+    // headers that claim more than the file holds, before LCM allocates.
+    int64_t count = 0;
+    while (const lcm::LogEvent* ev = nextLogEvent(log, path_)) handle(*ev, count++);
     if (count == 0) throw InputError(path_, 0, "the log holds no events");
     finishSlot();
     run_.refused = refusals_.refusals();

@@ -13,10 +13,11 @@
 
 namespace dlslot {
 
-// The next event of `log`, or nullptr at the end of the file. Throws InputError(path, ...) when
-// the bytes at the read position are not an event LCM can read: no sync word there (garbage
-// between events), a header cut off, a channel length outside 1..999, a negative data length, or
-// lengths that run past the end of the file.
+// The next event of `log`, or nullptr at the end of the file: a log read to its end holds
+// nothing but whole events. Throws InputError(path, ...) for a path that is not a regular file
+// and when the bytes at the read position are not an event LCM can read: no sync word there
+// (garbage between events), a header cut off, a channel length outside 1..999, a negative data
+// length, or lengths that run past the end of the file.
 const lcm::LogEvent* nextLogEvent(lcm::LogFile& log, const std::string& path);
 
 }  // namespace dlslot

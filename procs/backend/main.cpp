@@ -12,6 +12,7 @@
 #include "backend/backend_messages.hpp"
 #include "backend/heap_memory.hpp"
 #include "dlslot/frame_joiner.hpp"
+#include "dlslot/kitti.hpp"
 #include "dlslot/lcm_log.hpp"
 #include "backend/sliding_window.hpp"
 #include "dlslot/node.hpp"
@@ -42,6 +43,23 @@ BackendInput toInput(const Joiner::Joined& j) {
   return in;
 }
 
+// --ego-truth: the odometry of frame k replaced by the true motion (poses re-based on frame 0, as
+// the odometry's world is), trusted to 1 mm and 0.01 mrad a frame. What the objects would get
+// from a perfect ego: the bound no ego estimate can beat, for the object side alone.
+void useTrueEgo(const std::vector<Pose>& truth, const std::string& path, BackendInput& in) {
+  if (in.frame < 0 || in.frame >= static_cast<int>(truth.size()))
+    throw std::runtime_error(path + ": no pose for frame " + std::to_string(in.frame) + " (file has " +
+                             std::to_string(truth.size()) + ")");
+  const Pose origin_inv = truth.front().inverse();
+  OdometryInput odometry;
+  odometry.pose = origin_inv * truth[in.frame];
+  odometry.delta = in.frame == 0 ? Pose::Identity() : truth[in.frame - 1].inverse() * truth[in.frame];
+  Vector6 sigma;
+  sigma << 1e-3, 1e-3, 1e-3, 1e-5, 1e-5, 1e-5;
+  odometry.covariance = sigma.cwiseAbs2().asDiagonal();
+  in.odometry = odometry;
+}
+
 double nowSeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -65,7 +83,9 @@ void report(ProcessStatus& status, const BackendOutput& out) {
 
 // Offline: every ODOMETRY and ASSOCIATIONS event of a log, joined by frame, in frame order.
 int runOffline(const BackendConfig& config, const Channels& channels, const std::string& in_path,
-               const std::string& out_path) {
+               const std::string& out_path, const std::string& ego_truth_path) {
+  const std::vector<Pose> ego_truth = ego_truth_path.empty() ? std::vector<Pose>{} : kitti::readPoses(ego_truth_path);
+  if (!ego_truth_path.empty() && ego_truth.empty()) throw std::runtime_error(ego_truth_path + ": no poses");
   lcm::LogFile in(in_path, "r");
   if (!in.good()) throw std::runtime_error(in_path + ": cannot open LCM log for reading");
   Joiner joiner(std::numeric_limits<double>::infinity());
@@ -101,7 +121,9 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   std::map<int, slot_state_t> states;
   std::map<int, int> inputs_left;  // frame -> its input events not yet copied to the output
   for (const Joiner::Joined& j : joiner.flush()) {
-    const BackendOutput result = window.process(toInput(j));
+    BackendInput input = toInput(j);
+    if (!ego_truth.empty()) useTrueEgo(ego_truth, ego_truth_path, input);
+    const BackendOutput result = window.process(input);
     ++frames;
     missing_odometry += result.odometry_missing;
     missing_associations += result.associations_missing;
@@ -199,7 +221,7 @@ int runLive(const BackendConfig& config, const Channels& channels, const NodeOpt
 int main(int argc, char** argv) {
   return runMain("dlslot-backend", [&] {
     NodeOptions opts;
-    std::string mode, offline_in, offline_out;
+    std::string mode, offline_in, offline_out, ego_truth;
     CommandLine cl("dlslot-backend",
                    "Sliding-window optimization of ego poses, landmarks and objects (DL-SLOT III-C): "
                    "ODOMETRY + ASSOCIATIONS -> SLOT_STATE.");
@@ -208,8 +230,12 @@ int main(int argc, char** argv) {
     cl.option("--offline", &offline_in, "read ODOMETRY and ASSOCIATIONS from this LCM log instead of the network");
     cl.option("--out", &offline_out,
               "with --offline: write the input log with this run's SLOT_STATE (replacing any recorded one) here");
+    cl.option("--ego-truth", &ego_truth,
+              "with --offline: replace the odometry by these true T_world_lidar poses (KITTI 3x4 lines, e.g. a "
+              "simulated sequence's training/poses/0000.txt): the objects' accuracy with a perfect ego");
     if (!cl.parse(argc, argv)) return 0;
     if (!offline_out.empty() && offline_in.empty()) throw std::invalid_argument("--out needs --offline");
+    if (!ego_truth.empty() && offline_in.empty()) throw std::invalid_argument("--ego-truth needs --offline");
 
     Channels channels;
     ConfigSection root = loadPipelineConfig(opts.config, channels);
@@ -222,7 +248,7 @@ int main(int argc, char** argv) {
     if (!mode.empty()) config.mode = parseMode(mode);
     if (opts.check_config) return 0;
     retainFreedMemory();
-    if (!offline_in.empty()) return runOffline(config, channels, offline_in, offline_out);
+    if (!offline_in.empty()) return runOffline(config, channels, offline_in, offline_out, ego_truth);
     return runLive(config, channels, opts, join_timeout_s);
   });
 }

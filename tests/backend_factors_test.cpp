@@ -591,4 +591,17 @@ TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
       EXPECT_NE(std::string(e.what()).find("cfg.yaml: backend.constant_acceleration_sigma"), std::string::npos) << e.what();
     }
   }
+  // The odometry covariance scale: translation and rotation factors.
+  EXPECT_EQ(c.odometry_covariance_scale, Eigen::Vector2d(5.0, 20.0));
+  for (const char* bad : {"20", "[5, 20, 1]", "[5, 0]"}) {
+    YAML::Node node = YAML::LoadFile(std::string(DLSLOT_SOURCE_DIR) + "/config/dlslot.yaml")["backend"];
+    node["odometry_covariance_scale"] = YAML::Load(bad);
+    ConfigSection edited(node, "cfg.yaml", "backend");
+    try {
+      BackendConfig::read(edited);
+      ADD_FAILURE() << bad;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("cfg.yaml: backend.odometry_covariance_scale"), std::string::npos) << e.what();
+    }
+  }
 }

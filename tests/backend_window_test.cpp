@@ -159,7 +159,7 @@ SimScene streetScene() {
 BackendConfig streetConfig() {
   BackendConfig c;
   c.compute_covariance = false;
-  c.odometry_covariance_scale = 1.0;
+  c.odometry_covariance_scale = Eigen::Vector2d(1.0, 1.0);
   return c;
 }
 
@@ -325,7 +325,7 @@ TEST(BackendSlidingWindow, FallenBackOdometryKeepsAStoppedEgoInPlace) {
     inputs[f].odometry->covariance = placeholder;
   }
   BackendConfig c = streetConfig();
-  c.odometry_covariance_scale = 20.0;
+  c.odometry_covariance_scale = Eigen::Vector2d(5.0, 20.0);
   SlidingWindow window(c);
   const auto out = run(window, inputs);
   double worst = 0;

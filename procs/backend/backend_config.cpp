@@ -73,8 +73,11 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   s.get("degraded_odometry_scale", c.degraded_odometry_scale);
   require(c.degraded_odometry_scale >= 1.0, s, "degraded_odometry_scale", "a number >= 1");
   s.get("use_odometry_covariance", c.use_odometry_covariance);
-  s.get("odometry_covariance_scale", c.odometry_covariance_scale);
-  require(c.odometry_covariance_scale > 0.0, s, "odometry_covariance_scale", "a number > 0");
+  std::vector<double> scale{c.odometry_covariance_scale.x(), c.odometry_covariance_scale.y()};
+  s.get("odometry_covariance_scale", scale);
+  require(scale.size() == 2 && scale[0] > 0.0 && scale[1] > 0.0, s, "odometry_covariance_scale",
+          "two factors > 0 [translation, rotation]");
+  c.odometry_covariance_scale = Eigen::Vector2d(scale[0], scale[1]);
   s.get("observation_loss", c.observation_loss);
   require(c.observation_loss == "none" || c.observation_loss == "huber" || c.observation_loss == "cauchy", s,
           "observation_loss", "none, huber or cauchy");

@@ -46,11 +46,11 @@ struct BackendConfig {
   // Odometry sigmas are multiplied by this when the odometry fell back to a prediction or
   // did not arrive (then the pose is predicted with constant velocity).
   double degraded_odometry_scale = 10.0;
-  // Use the odometry message's covariance, its standard deviations times
-  // odometry_covariance_scale (a Hessian's covariance is optimistic), instead of odometry_sigma
-  // when it is valid.
+  // Use the odometry message's covariance, its translation and rotation standard deviations
+  // times odometry_covariance_scale's two factors (a Hessian's covariance is optimistic),
+  // instead of odometry_sigma when it is valid.
   bool use_odometry_covariance = true;
-  double odometry_covariance_scale = 5.0;
+  Eigen::Vector2d odometry_covariance_scale = Eigen::Vector2d(5.0, 5.0);  // translation, rotation
 
   // Robust loss on (landmark) observations, the factors that see outliers: none|huber|cauchy,
   // scale in whitened units (1 = one sigma).

@@ -121,9 +121,12 @@ void SlidingWindow::addEgoFrame(const BackendInput& in) {
     S /= config_.degraded_odometry_scale;
   } else if (config_.use_odometry_covariance) {
     Eigen::LLT<Matrix6> llt(in.odometry->covariance);
-    // S = L^-1 with Sigma = L L^T gives S^T S = Sigma^-1.
+    // S = L^-1 with Sigma = L L^T gives S^T S = Sigma^-1; the covariance D Sigma D, with D the
+    // translation and rotation scale factors, has S D^-1.
+    Vector6 scale;
+    scale << config_.odometry_covariance_scale.x() * Eigen::Vector3d::Ones(), config_.odometry_covariance_scale.y() * Eigen::Vector3d::Ones();
     if (llt.info() == Eigen::Success && in.odometry->covariance.allFinite())
-      S = llt.matrixL().solve(Matrix6::Identity()) / config_.odometry_covariance_scale;
+      S = llt.matrixL().solve(Matrix6::Identity()) * scale.cwiseInverse().asDiagonal();
   }
   addFactor(OdometryFactor::Create(delta, S), false, {x_prev, x});
 }

@@ -80,9 +80,10 @@ class SlidingWindow {
   void addEgoFrame(const BackendInput& in);
   void addObservations(const BackendInput& in);
   void startTrack(Track& track, int frame);
-  // A track without a chain spanning the window: windowMotion, for a vehicle turned toward the
-  // mean heading of its boxes (velocityAlongHeading).
-  std::optional<Eigen::Vector3d> youngVelocity(const Track& track) const;
+  // The velocity of the line through the track's boxes in the window (windowMotion), for a
+  // vehicle turned toward the mean heading of its boxes (velocityAlongHeading): a young
+  // vehicle's, and a pedestrian's at every age.
+  std::optional<Eigen::Vector3d> boxLineVelocity(const Track& track) const;
   // The least-squares motion of the track's observed positions in the window (world frame).
   std::optional<SpeedFit> windowMotion(const Track& track) const;
   void addTrackObservation(Track& track, int frame);

@@ -579,29 +579,21 @@ TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
   EXPECT_NEAR(S(0, 0), 1.0 / c.odometry_sigma[0], 1e-12);
   EXPECT_EQ(parseMode("two-stage"), Mode::kTwoStage);
   EXPECT_THROW(parseMode("joint"), std::invalid_argument);
-  // A sigma list of the wrong length or with a non-positive entry names the key and the form.
-  for (const char* bad : {"[0.005, 0.005]", "[0.005, 0.0, 0.005]"}) {
+  // A bad value under `key` is a config error naming the file and the key.
+  auto expectRefused = [](const std::string& key, const char* bad) {
     YAML::Node node = YAML::LoadFile(std::string(DLSLOT_SOURCE_DIR) + "/config/dlslot.yaml")["backend"];
-    node["constant_acceleration_sigma"] = YAML::Load(bad);
+    node[key] = YAML::Load(bad);
     ConfigSection edited(node, "cfg.yaml", "backend");
     try {
       BackendConfig::read(edited);
-      ADD_FAILURE() << bad;
+      ADD_FAILURE() << key << ": " << bad;
     } catch (const ConfigError& e) {
-      EXPECT_NE(std::string(e.what()).find("cfg.yaml: backend.constant_acceleration_sigma"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("cfg.yaml: backend." + key), std::string::npos) << e.what();
     }
-  }
-  // The odometry covariance scale: translation and rotation factors.
+  };
+  // A sigma list of the wrong length or with a non-positive entry.
+  for (const char* bad : {"[0.005, 0.005]", "[0.005, 0.0, 0.005]"}) expectRefused("constant_acceleration_sigma", bad);
+  // The odometry covariance scale: two factors, translation and rotation.
   EXPECT_EQ(c.odometry_covariance_scale, Eigen::Vector2d(5.0, 20.0));
-  for (const char* bad : {"20", "[5, 20, 1]", "[5, 0]"}) {
-    YAML::Node node = YAML::LoadFile(std::string(DLSLOT_SOURCE_DIR) + "/config/dlslot.yaml")["backend"];
-    node["odometry_covariance_scale"] = YAML::Load(bad);
-    ConfigSection edited(node, "cfg.yaml", "backend");
-    try {
-      BackendConfig::read(edited);
-      ADD_FAILURE() << bad;
-    } catch (const ConfigError& e) {
-      EXPECT_NE(std::string(e.what()).find("cfg.yaml: backend.odometry_covariance_scale"), std::string::npos) << e.what();
-    }
-  }
+  for (const char* bad : {"20", "[5, 20, 1]", "[5, 0]"}) expectRefused("odometry_covariance_scale", bad);
 }

@@ -21,6 +21,29 @@ TEST(BackendMotionEvidence, FitSpeedIsTheLeastSquaresLine) {
   EXPECT_FALSE(fitSpeed({p[0]}, 0.2));
 }
 
+// highway-jam seed 3's oncoming van: its first box (0.5 s before the others, 3 m aside) was
+// another object's. The least-squares line through all four says -3.2 m/s; a residual test after
+// it would drop the wrong box (the line passes 0.6 m from the stray one, 1.9 m from a good one).
+TEST(BackendMotionEvidence, FitAmongOutliersLeavesOutAnotherObjectsBox) {
+  const std::vector<TimedPosition> p{{7.7, Eigen::Vector3d(141.84, 8.35, 0)},
+                                     {8.2, Eigen::Vector3d(142.77, 5.38, 0)},
+                                     {8.3, Eigen::Vector3d(140.98, 5.02, 0)},
+                                     {8.4, Eigen::Vector3d(138.48, 5.47, 0)}};
+  EXPECT_NEAR(fitSpeed(p, 0.3)->velocity.x(), -3.18, 0.01);
+  const auto robust = fitSpeedAmongOutliers(p, 0.3, 5.0);
+  ASSERT_TRUE(robust);
+  const auto without = fitSpeed({p[1], p[2], p[3]}, 0.3);
+  EXPECT_TRUE(robust->velocity.isApprox(without->velocity, 1e-12));  // the line through the last three
+  EXPECT_NEAR(robust->velocity.x(), -21.45, 0.01);
+  EXPECT_NEAR(robust->sigma, without->sigma, 1e-12);
+  // Consistent positions keep every one: the plain least-squares line.
+  std::vector<TimedPosition> line;
+  for (int k = 0; k < 6; ++k) line.push_back({0.1 * k, Eigen::Vector3d(2.4 * k + (k % 2 ? 0.1 : -0.1), 0, 0)});
+  EXPECT_TRUE(fitSpeedAmongOutliers(line, 0.2, 5.0)->velocity.isApprox(fitSpeed(line, 0.2)->velocity, 1e-12));
+  // Three or fewer positions: no consensus to find, the plain line.
+  EXPECT_TRUE(fitSpeedAmongOutliers({p[0], p[1], p[2]}, 0.3, 5.0)->velocity.isApprox(fitSpeed({p[0], p[1], p[2]}, 0.3)->velocity, 1e-12));
+}
+
 TEST(BackendMotionEvidence, VelocityAlongHeadingWeighsTheTwoEstimates) {
   SpeedFit fit;
   fit.velocity = Eigen::Vector3d(10.0, 1.0, 0.3);  // 1 m/s across a heading along x

@@ -468,10 +468,11 @@ TEST(BackendSlidingWindow, FactorMembershipFollowsEquation12) {
   EXPECT_EQ(factors, (std::vector<int>{1, 2, 4, 7, 11}));
 }
 
-// A walker the tracker now and then gives a stray box 1.2 m to its side (a wrong association in a
-// crowd): its velocity is the line through its boxes in the window, which one such box bends by
-// up to 0.85 m/s here; the chain's newest pose change (before) swung by up to 1.82 m/s.
-TEST(BackendSlidingWindow, APedestriansVelocitySurvivesStrayBoxes) {
+namespace {
+
+// The worst velocity error of a walker (1.4 m/s) the tracker now and then gives a stray box
+// `aside` m to its side (a wrong association in a crowd), from frame 12 on.
+double walkerWithStrayBoxes(double aside) {
   SimScene scene;
   scene.ego = constantTwist(Pose::Identity(), 8.0, 0.0);
   scene.box_noise << 0.08, 0.08, 0.03;
@@ -485,7 +486,7 @@ TEST(BackendSlidingWindow, APedestriansVelocitySurvivesStrayBoxes) {
   walker.visible = [stray](int f) { return !stray.count(f); };
   scene.objects = {walker};
   for (int f : stray) {
-    const Pose b = scene.egoTruth(f).inverse() * walker.pose(scene.time(f)) * planarPose(0, 1.2, 0);
+    const Pose b = scene.egoTruth(f).inverse() * walker.pose(scene.time(f)) * planarPose(0, aside, 0);
     ObservationInput obs;
     obs.track_id = 5;
     obs.initialized = true;
@@ -505,8 +506,19 @@ TEST(BackendSlidingWindow, APedestriansVelocitySurvivesStrayBoxes) {
   for (int t = 12; t < 40; ++t)
     for (const TrackEstimate& e : out[t].tracks)
       if (e.id == 5) worst = std::max(worst, (e.velocity - truth).head<2>().norm());
-  std::printf("walker with stray boxes: worst velocity error %.2f m/s\n", worst);
-  EXPECT_LT(worst, 1.2);
+  return worst;
+}
+
+}  // namespace
+
+// A pedestrian's velocity is the line through its boxes in the window among outliers: a stray box
+// 1.2 m aside, too near to be left out, bends it by up to 1.02 m/s (its chain's newest pose change,
+// as before: 1.82); one 4 m aside is left out.
+TEST(BackendSlidingWindow, APedestriansVelocitySurvivesStrayBoxes) {
+  const double near = walkerWithStrayBoxes(1.2), far = walkerWithStrayBoxes(4.0);
+  std::printf("walker with stray boxes: worst velocity error %.2f m/s (1.2 m aside), %.2f m/s (4 m aside)\n", near, far);
+  EXPECT_LT(near, 1.2);
+  EXPECT_LT(far, 0.6);
 }
 
 TEST(BackendSlidingWindow, TwoStageAndOdometryOnlyKeepTheOdometryPoses) {

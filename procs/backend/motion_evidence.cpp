@@ -29,6 +29,39 @@ std::optional<SpeedFit> fitSpeed(const std::vector<TimedPosition>& positions, do
   return fit;
 }
 
+std::optional<SpeedFit> fitSpeedAmongOutliers(const std::vector<TimedPosition>& positions, double position_sigma,
+                                              double inlier_sigmas) {
+  if (positions.size() <= 3) return fitSpeed(positions, position_sigma);
+  // The line through the pair of positions with the most others within inlier_sigmas x
+  // position_sigma of it (bird's-eye; ties: the smaller squared residual), then the least-squares
+  // line through those. A residual test after a least-squares fit misses the stray box: with four
+  // boxes the line it bends passes nearer the stray one than the others.
+  const double gate = inlier_sigmas * position_sigma;
+  std::vector<TimedPosition> best;
+  double best_cost = 0;
+  for (size_t i = 0; i < positions.size(); ++i) {
+    for (size_t j = i + 1; j < positions.size(); ++j) {
+      const double dt = positions[j].t - positions[i].t;
+      if (std::abs(dt) < 1e-9) continue;
+      const Eigen::Vector3d v = (positions[j].p - positions[i].p) / dt;
+      std::vector<TimedPosition> in;
+      double cost = 0;
+      for (const TimedPosition& tp : positions) {
+        const double r = (tp.p - positions[i].p - v * (tp.t - positions[i].t)).head<2>().norm();
+        if (r <= gate) {
+          in.push_back(tp);
+          cost += r * r;
+        }
+      }
+      if (in.size() > best.size() || (in.size() == best.size() && cost < best_cost)) {
+        best = std::move(in);
+        best_cost = cost;
+      }
+    }
+  }
+  return best.size() >= 2 ? fitSpeed(best, position_sigma) : fitSpeed(positions, position_sigma);
+}
+
 Eigen::Vector3d velocityAlongHeading(const SpeedFit& fit, const Eigen::Vector2d& heading, double heading_sigma) {
   const Eigen::Vector2d v = fit.velocity.head<2>();
   const Eigen::Vector2d across(-heading.y(), heading.x());

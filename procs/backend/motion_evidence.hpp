@@ -24,6 +24,10 @@ struct SpeedFit {
 // distinct times. A static object's fitted speed is noise of about `sigma` per axis, so a speed
 // of a few sigmas is evidence of motion.
 std::optional<SpeedFit> fitSpeed(const std::vector<TimedPosition>& positions, double position_sigma);
+// The same line with the boxes the tracker gave the wrong track left out: the consensus of the
+// pairs of positions (more than 3 positions; else fitSpeed).
+std::optional<SpeedFit> fitSpeedAmongOutliers(const std::vector<TimedPosition>& positions, double position_sigma,
+                                              double inlier_sigmas);
 
 // A wheeled vehicle moves along its heading. The fit's velocity component across the unit
 // bird's-eye `heading` is that of positions alone (standard deviation fit.sigma); the heading

@@ -43,16 +43,24 @@ BackendInput toInput(const Joiner::Joined& j) {
   return in;
 }
 
-// --ego-truth: the odometry of frame k replaced by the true motion (poses re-based on frame 0, as
-// the odometry's world is), trusted to 1 mm and 0.01 mrad a frame. What the objects would get
-// from a perfect ego: the bound no ego estimate can beat, for the object side alone.
+// The true poses of --ego-truth, re-based on frame 0 as the odometry's world is.
+std::vector<Pose> readTrueEgo(const std::string& path) {
+  std::vector<Pose> truth = kitti::readPoses(path);
+  if (truth.empty()) throw std::runtime_error(path + ": no poses");
+  const Pose origin_inv = truth.front().inverse();
+  for (Pose& T : truth) T = origin_inv * T;
+  return truth;
+}
+
+// --ego-truth: the odometry of frame k replaced by the true motion, trusted to 1 mm and 0.01 mrad
+// a frame. What the objects would get from a perfect ego: the bound no ego estimate can beat, for
+// the object side alone.
 void useTrueEgo(const std::vector<Pose>& truth, const std::string& path, BackendInput& in) {
   if (in.frame < 0 || in.frame >= static_cast<int>(truth.size()))
     throw std::runtime_error(path + ": no pose for frame " + std::to_string(in.frame) + " (file has " +
                              std::to_string(truth.size()) + ")");
-  const Pose origin_inv = truth.front().inverse();
   OdometryInput odometry;
-  odometry.pose = origin_inv * truth[in.frame];
+  odometry.pose = truth[in.frame];
   odometry.delta = in.frame == 0 ? Pose::Identity() : truth[in.frame - 1].inverse() * truth[in.frame];
   Vector6 sigma;
   sigma << 1e-3, 1e-3, 1e-3, 1e-5, 1e-5, 1e-5;
@@ -84,8 +92,7 @@ void report(ProcessStatus& status, const BackendOutput& out) {
 // Offline: every ODOMETRY and ASSOCIATIONS event of a log, joined by frame, in frame order.
 int runOffline(const BackendConfig& config, const Channels& channels, const std::string& in_path,
                const std::string& out_path, const std::string& ego_truth_path) {
-  const std::vector<Pose> ego_truth = ego_truth_path.empty() ? std::vector<Pose>{} : kitti::readPoses(ego_truth_path);
-  if (!ego_truth_path.empty() && ego_truth.empty()) throw std::runtime_error(ego_truth_path + ": no poses");
+  const std::vector<Pose> ego_truth = ego_truth_path.empty() ? std::vector<Pose>{} : readTrueEgo(ego_truth_path);
   lcm::LogFile in(in_path, "r");
   if (!in.good()) throw std::runtime_error(in_path + ": cannot open LCM log for reading");
   Joiner joiner(std::numeric_limits<double>::infinity());

@@ -37,29 +37,31 @@ std::optional<SpeedFit> fitSpeedAmongOutliers(const std::vector<TimedPosition>& 
   // line through those. A residual test after a least-squares fit misses the stray box: with four
   // boxes the line it bends passes nearer the stray one than the others.
   const double gate = inlier_sigmas * position_sigma;
-  std::vector<TimedPosition> best;
-  double best_cost = 0;
-  for (size_t i = 0; i < positions.size(); ++i) {
-    for (size_t j = i + 1; j < positions.size(); ++j) {
-      const double dt = positions[j].t - positions[i].t;
-      if (std::abs(dt) < 1e-9) continue;
-      const Eigen::Vector3d v = (positions[j].p - positions[i].p) / dt;
-      std::vector<TimedPosition> in;
-      double cost = 0;
-      for (const TimedPosition& tp : positions) {
-        const double r = (tp.p - positions[i].p - v * (tp.t - positions[i].t)).head<2>().norm();
-        if (r <= gate) {
-          in.push_back(tp);
-          cost += r * r;
-        }
-      }
-      if (in.size() > best.size() || (in.size() == best.size() && cost < best_cost)) {
-        best = std::move(in);
-        best_cost = cost;
-      }
+  // The positions within the gate of the line through positions i and j, and their squared residuals.
+  auto inliers = [&](size_t i, size_t j, std::vector<TimedPosition>* out) {
+    const Eigen::Vector3d v = (positions[j].p - positions[i].p) / (positions[j].t - positions[i].t);
+    int n = 0;
+    double cost = 0;
+    for (const TimedPosition& tp : positions) {
+      const double r = (tp.p - positions[i].p - v * (tp.t - positions[i].t)).head<2>().norm();
+      if (r > gate) continue;
+      ++n, cost += r * r;
+      if (out) out->push_back(tp);
     }
-  }
-  return best.size() >= 2 ? fitSpeed(best, position_sigma) : fitSpeed(positions, position_sigma);
+    return std::make_pair(n, cost);
+  };
+  std::pair<int, double> best{0, 0.0};
+  size_t best_i = 0, best_j = 0;
+  for (size_t i = 0; i < positions.size(); ++i)
+    for (size_t j = i + 1; j < positions.size(); ++j) {
+      if (std::abs(positions[j].t - positions[i].t) < 1e-9) continue;
+      const auto [n, cost] = inliers(i, j, nullptr);
+      if (n > best.first || (n == best.first && cost < best.second)) best = {n, cost}, best_i = i, best_j = j;
+    }
+  if (best.first < 2) return fitSpeed(positions, position_sigma);
+  std::vector<TimedPosition> kept;
+  inliers(best_i, best_j, &kept);
+  return fitSpeed(kept, position_sigma);
 }
 
 Eigen::Vector3d velocityAlongHeading(const SpeedFit& fit, const Eigen::Vector2d& heading, double heading_sigma) {

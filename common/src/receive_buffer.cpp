@@ -77,6 +77,11 @@ std::string mb(int64_t bytes) {
 
 }  // namespace
 
+int lcmReceiveSocket(int port) {
+  const std::vector<int> fds = socketsOnPort(port);
+  return fds.empty() ? -1 : fds.front();
+}
+
 ReceiveBuffer enlargeLcmReceiveBuffer(int port, int64_t bytes) {
   ReceiveBuffer r;
   r.requested = bytes;

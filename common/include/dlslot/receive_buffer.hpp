@@ -25,6 +25,9 @@ struct ReceiveBuffer {
   std::string note;       // one line saying what was asked and what was granted, and how
 };
 
+// This process's UDP socket bound to `port` (LCM's receive socket, once made); -1 when none.
+int lcmReceiveSocket(int port);
+
 // Finds this process's UDP socket bound to `port` (LCM's receive socket: create it first, e.g.
 // with lcm::LCM::getFileno(); LCM's sending socket is not bound to it) and asks for `bytes`:
 // SO_RCVBUFFORCE, else SO_RCVBUF.

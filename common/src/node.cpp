@@ -229,18 +229,24 @@ Node::Node(std::string name, const std::string& lcm_url, const Channels& channel
                              (lcm_url.empty() ? std::string("(default)") : lcm_url) + "'");
   const char* env = std::getenv("LCM_DEFAULT_URL");
   const std::string url = !lcm_url.empty() ? lcm_url : env ? env : "";
-  if (const int64_t want = requestedReceiveBuffer(url); want > 0) {
-    lcm_.getFileno();  // creates LCM's receive socket (it is otherwise made on first use)
-    const ReceiveBuffer rb = enlargeLcmReceiveBuffer(lcmPort(url), want);
-    recv_fd_ = rb.fd;
-    status_.set("recv_buffer_bytes", rb.granted);
-    std::fprintf(stderr, "[%s] %s\n", name_.c_str(), rb.note.c_str());
-  } else if (const int port = lcmPort(url); port > 0) {
+  if (const int port = lcmPort(url); port > 0) {
+    // LCM's receive socket is the one that appears when LCM makes it (on first use): any other on
+    // the port was inherited (dlslot-run's children hold the launcher's, a test's launcher the
+    // test's), and a filter or buffer size set on it would act on the other process's socket.
+    const std::vector<int> before = udpSocketsOnPort(port);
     lcm_.getFileno();
-    recv_fd_ = lcmReceiveSocket(port);
+    for (const int fd : udpSocketsOnPort(port))
+      if (std::find(before.begin(), before.end(), fd) == before.end()) recv_fd_ = fd;
   }
-  // No subscription yet, so no point cloud is wanted until one subscribes to the scan channel.
-  if (recv_fd_ >= 0) filtering_large_ = attachLargeMessageFilter(recv_fd_);
+  if (recv_fd_ >= 0) {
+    if (const int64_t want = requestedReceiveBuffer(url); want > 0) {
+      const ReceiveBuffer rb = enlargeReceiveBuffer(recv_fd_, want);
+      status_.set("recv_buffer_bytes", rb.granted);
+      std::fprintf(stderr, "[%s] %s\n", name_.c_str(), rb.note.c_str());
+    }
+    // No subscription yet, so no point cloud is wanted until one subscribes to the scan channel.
+    filtering_large_ = attachLargeMessageFilter(recv_fd_);
+  }
 }
 
 void Node::noteSubscription(const std::string& channel) {

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -368,6 +369,23 @@ TEST(FoxgloveConvert, UnwantedTopicsAreNotBuiltButStateIsKept) {
   conv.add(slotState(1, {1}), out);
   ASSERT_EQ(out.size(), 2u);
   EXPECT_EQ(YAML::Load(out[1].json)["poses"].size(), 2u);
+}
+
+TEST(FoxgloveLayout, TheShippedLayoutShowsTopicsTheConverterWrites) {
+  const YAML::Node layout = YAML::LoadFile(std::string(DLSLOT_SOURCE_DIR) + "/config/foxglove-layout.json");
+  std::set<std::string> topics;
+  for (const auto& t : foxglove::Converter().topics()) topics.insert(t.name);
+  const YAML::Node panel = layout["configById"]["3D!dlslot"];
+  ASSERT_TRUE(panel.IsMap());
+  EXPECT_EQ(panel["followTf"].as<std::string>(), foxglove::kLidarFrame);
+  EXPECT_EQ(panel["layers"]["grid"]["frameId"].as<std::string>(), foxglove::kWorldFrame);
+  int shown = 0;
+  for (const auto& kv : panel["topics"]) {
+    EXPECT_TRUE(topics.count(kv.first.as<std::string>())) << kv.first.as<std::string>();
+    shown += kv.second["visible"].as<bool>();
+  }
+  EXPECT_GE(shown, 4);
+  EXPECT_TRUE(topics.count(layout["configById"]["RawMessages!dlslotstatus"]["topicPath"].as<std::string>()));
 }
 
 // ---- the exporter, read back by @mcap/core ----

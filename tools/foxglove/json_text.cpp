@@ -1,6 +1,8 @@
 #include "json_text.hpp"
 
+#include <array>
 #include <charconv>
+#include <cstring>
 #include <cmath>
 #include <cstdio>
 
@@ -8,17 +10,22 @@ namespace dlslot::foxglove {
 
 void appendBase64(std::string& out, const void* data, size_t size) {
   static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  // Two output characters per lookup (12 bits -> a pair): half the table loads of one per 6 bits,
+  // and a scan is megabytes of base64.
+  static const std::array<char[2], 4096> kPairs = [] {
+    std::array<char[2], 4096> t{};
+    for (int v = 0; v < 4096; ++v) t[v][0] = kAlphabet[v >> 6], t[v][1] = kAlphabet[v & 63];
+    return t;
+  }();
   const auto* p = static_cast<const unsigned char*>(data);
   const size_t start = out.size();
   out.resize(start + 4 * ((size + 2) / 3));
   char* o = &out[start];
   size_t i = 0;
-  for (; i + 3 <= size; i += 3) {
+  for (; i + 3 <= size; i += 3, o += 4) {
     const uint32_t v = (uint32_t{p[i]} << 16) | (uint32_t{p[i + 1]} << 8) | p[i + 2];
-    *o++ = kAlphabet[v >> 18];
-    *o++ = kAlphabet[(v >> 12) & 63];
-    *o++ = kAlphabet[(v >> 6) & 63];
-    *o++ = kAlphabet[v & 63];
+    std::memcpy(o, kPairs[v >> 12], 2);
+    std::memcpy(o + 2, kPairs[v & 0xFFF], 2);
   }
   if (i < size) {
     const uint32_t v = (uint32_t{p[i]} << 16) | (i + 1 < size ? uint32_t{p[i + 1]} << 8 : 0);

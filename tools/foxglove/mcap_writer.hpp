@@ -100,6 +100,7 @@ class Writer {
     std::map<uint16_t, uint64_t> index_offsets;
   };
   void put(const std::string& bytes);  // to the file, into the data CRC
+  void put(const std::string& bytes, uint32_t bytes_crc);  // the same, the bytes' CRC known
   void flushChunk();
   static void schemaRecord(Bytes& b, const Schema& s);
   static void channelRecord(Bytes& b, const Channel& c);

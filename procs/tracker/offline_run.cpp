@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "dlslot/input_error.hpp"
+#include "track_evidence.hpp"
 
 namespace dlslot::tracker {
 
@@ -49,6 +50,8 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
     if (all_around) out.tracks.push_back(std::move(row));
   };
   int max_id = -1;
+  std::map<int, TrackEvidence> evidence;
+  std::map<int, const ClassPolicy*> policy_of;
   for (int i = 0; i < reader.size(); ++i) {
     const Frame frame = reader.read(i);
     const auto tic = std::chrono::steady_clock::now();
@@ -61,6 +64,8 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
     for (const Association& a : r.associations) {
       ++out.associated;
       max_id = std::max(max_id, a.track_id);
+      evidence[a.track_id].add(frame.index, a.box_lidar.score);
+      policy_of.emplace(a.track_id, policyFor(config.classes, a.box_lidar.type));
       const bool confirmed = a.status == TrackStatus::Confirmed;
       out.confirmed += confirmed;
       if (output == TrackOutput::Confirmed && !confirmed) continue;
@@ -75,6 +80,8 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
     }
   }
   out.trajectories = max_id + 1;
+  // The score column: each track's evidence over its life (track_evidence.hpp).
+  writeTrackScores(out.tracks, evidence, policy_of);
   return out;
 }
 

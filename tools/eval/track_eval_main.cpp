@@ -71,6 +71,7 @@ std::map<std::string, KittiClassMetrics> combine(std::map<std::string, KittiClas
     if (const auto s = sweep.find(cls); s != sweep.end()) {
       k.sweep = s->second.sweep;
       k.sweep_ab3dmot = s->second.sweep_ab3dmot;
+      k.best_switches = s->second.best_switches;
     }
   return output;
 }
@@ -174,6 +175,14 @@ int run(int argc, char** argv) {
     json << "  \"" << kv[i].first << "\": " << (kv[i].second ? cell(kv[i].second, "%.9g") : "null")
          << (i + 1 < kv.size() ? ",\n" : "\n");
   json << "}\n";
+
+  // Where identities switch at the best threshold of the all-tracks output (what the score sweep
+  // reports as IDSW), for finding their causes.
+  std::ofstream switches(fs::path(out) / "switches.txt");
+  switches << "# class sequence frame label_id from_track to_track (data_all/, at the best single threshold)\n";
+  for (const auto& [cls, k] : overall)
+    for (const IdSwitch& w : k.best_switches)
+      switches << cls << " " << w.sequence << " " << w.frame << " " << w.label_id << " " << w.from << " " << w.to << "\n";
 
   std::ofstream report(fs::path(out) / "report.md");
   const char* what =

@@ -1,5 +1,6 @@
 #include "offline_run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <stdexcept>
@@ -38,7 +39,13 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
   if (static_cast<int>(ego_poses.size()) < reader.size())
     throw std::invalid_argument("ego poses: " + std::to_string(ego_poses.size()) + " for " +
                                 std::to_string(reader.size()) + " frames");
-  TrajectoryAssociator associator(config);
+  // Speeds over ground need ego poses: with none (every pose the identity, tracking in the sensor
+  // frame) a parked object moves at the ego's speed, so the class's speed limits cannot be judged.
+  AssociatorConfig cfg = config;
+  if (std::all_of(ego_poses.begin(), ego_poses.begin() + reader.size(),
+                  [](const Pose& X) { return X.matrix().isIdentity(0.0); }))
+    cfg.plausibility.clear();
+  TrajectoryAssociator associator(cfg);
   OfflineResult out;
   auto write = [&](int frame, const Box& box) {
     kitti::LabelRow row = kitti::unprojectedRow(frame, box, reader.calib());
@@ -61,6 +68,8 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
     out.skipped.untracked_type += r.skipped.untracked_type;
     out.skipped.below_score += r.skipped.below_score;
     out.skipped.duplicate += r.skipped.duplicate;
+    out.class_decisions.relabelled_too_fast += r.class_decisions.relabelled_too_fast;
+    out.class_decisions.suppressed_too_fast += r.class_decisions.suppressed_too_fast;
     for (const Association& a : r.associations) {
       ++out.associated;
       max_id = std::max(max_id, a.track_id);
@@ -68,6 +77,10 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
       policy_of.emplace(a.track_id, policyFor(config.classes, a.box_lidar.type));
       const bool confirmed = a.status == TrackStatus::Confirmed;
       out.confirmed += confirmed;
+      if (a.suppressed) {
+        ++out.suppressed_rows;
+        continue;
+      }
       if (output == TrackOutput::Confirmed && !confirmed) continue;
       Box box = a.box_lidar;
       box.id = a.track_id;

@@ -72,6 +72,7 @@ associations_t toMsg(const JoinedFrame& joined, const EgoPose& ego, const FrameA
   m.num_active_tracks = result.num_active_tracks;
   m.num_rejected = joined.a ? joined.a->num_rejected : 0;
   for (const Association& a : result.associations) {
+    if (a.suppressed) continue;  // its class's plausibility rules it out (counted in the status)
     association_t out;
     out.detection_index = joined.a->message_index[a.detection_index];
     out.track_id = a.track_id;
@@ -192,6 +193,9 @@ int run(int argc, char** argv) {
     status.count("detections_untracked_type", result.skipped.untracked_type);
     status.count("detections_below_score", result.skipped.below_score);
     status.count("detections_duplicate", result.skipped.duplicate);
+    // Tracks whose class the window overruled, by reason.
+    status.count("tracks_relabelled_too_fast", result.class_decisions.relabelled_too_fast);
+    status.count("tracks_suppressed_too_fast", result.class_decisions.suppressed_too_fast);
 
     associations_t msg = toMsg(joined, ego, result);
     const double ms = std::chrono::duration<double, std::milli>(Node::Clock::now() - tic).count();

@@ -114,7 +114,7 @@ int run(int argc, char** argv) {
     node.publish(channels.scan, scan);
 
     if (!no_detections) {
-      detections_t det;
+      detections_t det{};
       det.utime = frame.utime;
       det.frame = frame.index;
       det.boxes = toMsg(frame.detections);

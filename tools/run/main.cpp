@@ -297,8 +297,8 @@ int runPipeline(int argc, char** argv) {
   // Where the two cores went: each process's CPU time over the whole run, per played frame.
   {
     std::string line;
-    for (const std::string p : {"odometry", "tracker", "backend", "renderer", "player", "lcm-logger"}) {
-      if (p == std::string("renderer") && no_render) continue;
+    for (const std::string p : {"detector", "odometry", "tracker", "backend", "renderer", "player", "lcm-logger"}) {
+      if ((p == std::string("renderer") && no_render) || (p == std::string("detector") && !geometric)) continue;
       const double s = sup.cpuSeconds(p);
       if (s < 0) continue;
       char buf[96];
@@ -343,6 +343,9 @@ int runPipeline(int argc, char** argv) {
   }
   std::cout << "outputs in " << out << ": run.lcmlog, trajectory_*.txt, tracks_kitti.txt, metrics.json, report.md, "
             << (no_render ? "" : "bev/, ") << "plots/, config.yaml, logs/\n";
+  std::cout << "to look at it: report.md has every table; " << (no_render ? "" : "bev/ one bird's-eye image a frame "
+            "(points, boxes coloured by track with id and speed, the trajectories; any image viewer), ")
+            << "plots/ the trajectories and their errors\n";
   std::cout << std::flush;
   std::cerr << "dlslot-run: " << accounting.verdict() << "\n";
   if (accounting.hasLoss() && !allow_loss) return 4;

@@ -17,6 +17,7 @@
 #include "dlslot/slot_state_t.hpp"
 #include "ego_pose_chain.hpp"
 #include "offline_run.hpp"
+#include "slot_state_gate.hpp"
 #include "tracker_config.hpp"
 #include "trajectory_associator.hpp"
 
@@ -143,6 +144,10 @@ int run(int argc, char** argv) {
   cl.flag("--all-around", &off.all_around,
           "offline: also write tracks outside the camera image (2-D box -1), for labels all around the scan "
           "(simulated sequences); not for the KITTI devkit");
+  bool follow_slot_state = false;
+  cl.flag("--follow-slot-state", &follow_slot_state,
+          "associate a frame only after SLOT_STATE of the frame associated before it (or join_timeout_s): "
+          "the same poses as strict lockstep when the player keeps frames in flight (dlslot-player --in-flight)");
   if (!cl.parse(argc, argv)) return 0;
 
   Channels channels;
@@ -156,6 +161,7 @@ int run(int argc, char** argv) {
   TrajectoryAssociator associator(cfg.associator);
   EgoPoseChain ego_poses;
   Joiner joiner(cfg.join_timeout_s);
+  SlotStateGate<JoinedFrame> gate(follow_slot_state, cfg.join_timeout_s);
 
   auto process = [&](const JoinedFrame& joined) {
     const auto tic = Node::Clock::now();
@@ -199,7 +205,16 @@ int run(int argc, char** argv) {
     status.frameDone(joined.frame, ms);
   };
   auto releaseReady = [&] {
-    for (const JoinedFrame& joined : joiner.release(secondsNow())) process(joined);
+    const double now = secondsNow();
+    for (JoinedFrame& joined : joiner.release(now)) gate.push(joined.frame, std::move(joined), now);
+    int without = 0;
+    const int waited_for = gate.waitingFor();
+    for (const auto& [frame, joined] : gate.release(now, &without)) process(joined);
+    if (without > 0) {
+      status.timeout(channels.slot_state + " for frame " + std::to_string(waited_for) + " not within " +
+                     seconds(cfg.join_timeout_s) + "; associating without it");
+      status.count("slot_state_missing", without);
+    }
   };
   // A frame 0 after later frames: the player started again. Start from scratch.
   auto restartIfRewound = [&](int frame) {
@@ -207,6 +222,7 @@ int run(int argc, char** argv) {
     status.warn("frame 0 after frame " + std::to_string(joiner.lastReleased()) + ": input restarted, tracker reset");
     associator.reset();
     joiner.reset();
+    gate.reset();
     ego_poses = EgoPoseChain();
   };
 
@@ -232,6 +248,8 @@ int run(int argc, char** argv) {
   });
   node.subscribe<slot_state_t>(channels.slot_state, [&](const slot_state_t& msg) {
     ego_poses.addOptimized(msg.frame, fromMsg(msg.ego_pose));
+    gate.slotState(msg.frame);
+    releaseReady();
   });
   node.every(0.02, releaseReady);
   return node.run();

@@ -88,6 +88,10 @@ struct BackendOutput {
   // registered class whose previous scan's points were missing (new, or missed last frame).
   std::array<int, kNumRegistrationOutcomes> registrations{};
   int registration_no_previous = 0;
+  // Over this frame's registrations: the objects' points (previous scan) and the squared RMS
+  // point-to-plane residual, summed (to compare the simulator's objects with real ones).
+  int64_t registration_points = 0;
+  double registration_residual_sq = 0;
 };
 
 }  // namespace dlslot::backend

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -147,7 +148,8 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   int frames = 0, missing_odometry = 0, missing_associations = 0;
   int64_t landmarks = 0, moving = 0, switched = 0;  // summed over frames
   std::array<int64_t, kNumRegistrationOutcomes> registrations{};
-  int64_t registration_no_previous = 0;
+  int64_t registration_no_previous = 0, registration_points = 0;
+  double registration_residual_sq = 0;
   std::map<int, slot_state_t> states;
   std::map<int, int> inputs_left;  // frame -> its input events not yet copied to the output
   for (const Joiner::Joined& j : joiner.flush()) {
@@ -164,6 +166,8 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
     switched += result.static_to_dynamic;
     for (int k = 0; k < kNumRegistrationOutcomes; ++k) registrations[k] += result.registrations[k];
     registration_no_previous += result.registration_no_previous;
+    registration_points += result.registration_points;
+    registration_residual_sq += result.registration_residual_sq;
     states[j.frame] = toMsg(result, toString(config.mode));
     inputs_left[j.frame] = (j.a ? 1 : 0) + (j.b ? 1 : 0);
   }
@@ -213,6 +217,12 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   for (int k = 0; k < kNumRegistrationOutcomes; ++k)
     std::printf(" %s %lld", toString(static_cast<RegistrationOutcome>(k)), static_cast<long long>(registrations[k]));
   std::printf(", no previous scan %lld\n", static_cast<long long>(registration_no_previous));
+  int64_t attempts = 0;
+  for (int k = 0; k < kNumRegistrationOutcomes; ++k) attempts += registrations[k];
+  const int64_t ok = registrations[0] + registrations[1];
+  if (attempts > 0)
+    std::printf("  points per registered object %.0f; point-to-plane RMS of the measured ones %.4f m\n",
+                double(registration_points) / attempts, ok ? std::sqrt(registration_residual_sq / ok) : 0.0);
   return 0;
 }
 

@@ -195,6 +195,8 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
   }
   const RegistrationResult r = registerObject(*previous, *world, M0, obs.box.center.norm(), config_.registration);
   ++out.registrations[static_cast<int>(r.outcome)];
+  out.registration_points += r.source_points;
+  if (r.ok()) out.registration_residual_sq += r.rms_residual * r.rms_residual;
   if (r.ok()) track.motions[frame] = Track::Motion{r.motion, r.information};
 }
 

@@ -139,13 +139,14 @@ void Channels::read(ConfigSection s) {
   s.get("odometry", odometry);
   s.get("associations", associations);
   s.get("slot_state", slot_state);
+  s.get("map_state", map_state);
   s.get("status", status);
   s.finish();
 }
 
 ConfigSection loadPipelineConfig(const std::string& file, Channels& channels) {
   ConfigSection root = loadConfig(file);
-  for (const char* section : {"channels", "player", "detector", "odometry", "tracker", "backend", "renderer"}) root.skip(section);
+  for (const char* section : {"channels", "player", "detector", "odometry", "tracker", "backend", "renderer", "mapper"}) root.skip(section);
   root.finish();
   channels.read(root.section("channels"));
   return root;

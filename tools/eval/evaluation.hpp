@@ -14,9 +14,19 @@
 #include "ego_metrics.hpp"
 #include "hota.hpp"
 #include "kitti_protocol.hpp"
+#include "map_quality.hpp"
 #include "tracking_frames.hpp"
 
 namespace dlslot::eval {
+
+// dlslot-eval --map: the mapper's static map and loops.
+struct MapMetrics {
+  MapScore score;                  // null SA/DA when the scans or labels are not there
+  int loops_accepted = 0;
+  std::optional<int> loops_false;  // null without ground-truth poses
+  int keyframes = 0;
+  int64_t map_points = 0;
+};
 
 struct RunData {
   std::map<std::string, Trajectory> sources;  // the system's ego trajectories, by source name
@@ -34,6 +44,7 @@ struct RunData {
   std::vector<std::string> notes;                // facts for the report (process health, warnings)
   std::optional<FrameAccounting> frames;         // where every played frame went (a recorded run)
   std::map<std::string, RssSummary> memory;      // process -> resident memory over the run
+  std::optional<MapMetrics> map;                 // --map
 };
 
 struct EvalOptions {
@@ -62,6 +73,7 @@ struct Metrics {
   std::vector<std::string> notes;
   std::optional<FrameAccounting> frames;
   std::map<std::string, RssSummary> memory;
+  std::optional<MapMetrics> map;
 };
 
 std::string primarySource(const std::map<std::string, Trajectory>& sources);

@@ -87,7 +87,7 @@ int runPipeline(int argc, char** argv) {
   std::vector<std::string> detections;
   int frames = -1, seed = 1;
   double speed = 0, stall_s = 60, start_timeout_s = 30, heartbeat_s = 10;
-  bool no_eval = false, no_render = false, quiet = false, allow_loss = false;
+  bool no_eval = false, no_render = false, no_map = false, quiet = false, allow_loss = false;
   CommandLine cl("dlslot-run", "Runs player, odometry, tracker, backend, renderer and lcm-logger on one sequence.");
   cl.option("--kitti", &root, "KITTI root (holding training/ or sequences/)");
   cl.option("--sequence", &sequence, "sequence (default 0000)");
@@ -109,6 +109,7 @@ int runPipeline(int argc, char** argv) {
   cl.flag("--allow-loss", &allow_loss, "exit 0 even when frames were lost (they are still reported)");
   cl.flag("--no-eval", &no_eval, "skip the evaluation");
   cl.flag("--no-render", &no_render, "do not start the renderer");
+  cl.flag("--no-map", &no_map, "do not start the mapper (no map.pcd, map.png, trajectory_map_*)");
   cl.flag("--quiet", &quiet, "no progress line");
   if (!cl.parse(argc, argv)) return 0;
   if (out.empty()) throw std::invalid_argument("--out DIR is required");
@@ -128,8 +129,8 @@ int runPipeline(int argc, char** argv) {
     ConfigSection cfg = loadConfig(config);  // throws a clear ConfigError
     (void)cfg;
     fs::copy_file(config, out + "/config.yaml", fs::copy_options::overwrite_existing);
-    for (const std::string p : {"player", "detector", "odometry", "tracker", "backend", "renderer"}) {
-      if ((no_render && p == "renderer") || (!geometric && p == "detector")) continue;
+    for (const std::string p : {"player", "detector", "odometry", "tracker", "backend", "renderer", "mapper"}) {
+      if ((no_render && p == "renderer") || (!geometric && p == "detector") || (no_map && p == "mapper")) continue;
       const std::string log = logs + "/check-" + p + ".log";
       if (runToEnd(sup, "check-" + p, {bin + "/dlslot-" + p, "--config", config, "--check-config"}, log) != 0)
         throw ConfigError("dlslot-" + p + " refused the config:\n" + run::readText(log));
@@ -171,6 +172,12 @@ int runPipeline(int argc, char** argv) {
     std::vector<std::string> render_args = {"--out", out + "/bev"};
     if (speed > 0) render_args.push_back("--skip-when-behind");
     sup.start("renderer", args(bin + "/dlslot-renderer", render_args), logs + "/renderer.log");
+  }
+  if (!no_map) {
+    // The mapper is not on the lockstep path (the player waits for SLOT_STATE only); it writes
+    // the map files into the run folder when it is stopped.
+    pipeline.insert(pipeline.begin(), "mapper");
+    sup.start("mapper", args(bin + "/dlslot-mapper", {"--out", out}), logs + "/mapper.log");
   }
   sup.start("backend", args(bin + "/dlslot-backend", {"--mode", ms.backend}), logs + "/backend.log");
   sup.start("tracker", args(bin + "/dlslot-tracker", {}), logs + "/tracker.log");
@@ -287,9 +294,13 @@ int runPipeline(int argc, char** argv) {
   // logger closes the log).
   // The launcher keeps reading while it waits, so each process's last PROCESS_STATUS is heard.
   const auto listen = [&] { node.spinUntil([] { return false; }, 0.02); };
-  for (const std::string p : {"detector", "odometry", "tracker", "backend", "renderer"}) {
-    if ((p == std::string("renderer") && no_render) || (p == std::string("detector") && !geometric)) continue;
-    const int code = sup.stop(p, p == std::string("renderer") ? 60.0 : 10.0, listen);
+  for (const std::string p : {"detector", "odometry", "tracker", "backend", "mapper", "renderer"}) {
+    if ((p == std::string("renderer") && no_render) || (p == std::string("detector") && !geometric) ||
+        (p == std::string("mapper") && no_map))
+      continue;
+    // The mapper finishes its keyframes and loop closure and writes the map files before it exits.
+    const double grace = p == std::string("renderer") || p == std::string("mapper") ? 120.0 : 10.0;
+    const int code = sup.stop(p, grace, listen);
     if (code != 0) throw Failure(p + " did not exit cleanly (code " + std::to_string(code) + "):\n" + sup.tail(p));
   }
   node.spinUntil([] { return false; }, 0.3);
@@ -297,8 +308,8 @@ int runPipeline(int argc, char** argv) {
   // Where the two cores went: each process's CPU time over the whole run, per played frame.
   {
     std::string line;
-    for (const std::string p : {"odometry", "tracker", "backend", "renderer", "player", "lcm-logger"}) {
-      if (p == std::string("renderer") && no_render) continue;
+    for (const std::string p : {"odometry", "tracker", "backend", "mapper", "renderer", "player", "lcm-logger"}) {
+      if ((p == std::string("renderer") && no_render) || (p == std::string("mapper") && no_map)) continue;
       const double s = sup.cpuSeconds(p);
       if (s < 0) continue;
       char buf[96];
@@ -336,13 +347,15 @@ int runPipeline(int argc, char** argv) {
 
   // 6. Evaluate and export.
   if (!no_eval) {
-    const std::vector<std::string> eval = {bin + "/dlslot-eval", "--config", config, "--log", out + "/run.lcmlog",
-                                           "--kitti", root, "--sequence", sequence, "--out", out, "--export", out};
+    std::vector<std::string> eval = {bin + "/dlslot-eval", "--config", config, "--log", out + "/run.lcmlog",
+                                     "--kitti", root, "--sequence", sequence, "--out", out, "--export", out};
+    if (!no_map) eval.insert(eval.end(), {"--map", out});
     if (runToEnd(sup, "eval", eval, logs + "/eval.log") != 0) throw Failure("dlslot-eval failed:\n" + sup.tail("eval", 30));
     std::cout << run::readText(logs + "/eval.log");
   }
   std::cout << "outputs in " << out << ": run.lcmlog, trajectory_*.txt, tracks_kitti.txt, metrics.json, report.md, "
-            << (no_render ? "" : "bev/, ") << "plots/, config.yaml, logs/\n";
+            << (no_render ? "" : "bev/, ") << (no_map ? "" : "map.pcd, map_removed.pcd, map.png, ")
+            << "plots/, config.yaml, logs/\n";
   std::cout << std::flush;
   std::cerr << "dlslot-run: " << accounting.verdict() << "\n";
   if (accounting.hasLoss() && !allow_loss) return 4;

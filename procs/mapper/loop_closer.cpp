@@ -1,0 +1,186 @@
+#include "mapper/loop_closer.hpp"
+
+#include <chrono>
+#include <unordered_set>
+
+#include "dlslot/voxel_key.hpp"
+
+namespace dlslot::mapper {
+
+PointCloud voxelDownsample(const PointCloud& points, double voxel_m) {
+  std::unordered_set<uint64_t> seen;
+  seen.reserve(points.cols());
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index i = 0; i < points.cols(); ++i)
+    if (seen.insert(voxelKey(points.col(i).head<3>().cast<double>(), voxel_m)).second) keep.push_back(i);
+  PointCloud out(4, static_cast<Eigen::Index>(keep.size()));
+  for (size_t k = 0; k < keep.size(); ++k) out.col(static_cast<Eigen::Index>(k)) = points.col(keep[k]);
+  return out;
+}
+
+LoopCloser::LoopCloser(const LoopConfig& config, bool threaded) : config_(config), threaded_(threaded) {
+  sc_params_.rings = config.rings;
+  sc_params_.sectors = config.sectors;
+  sc_params_.max_radius_m = config.max_radius_m;
+  if (threaded_) worker_ = std::thread([this] { work(); });
+}
+
+LoopCloser::~LoopCloser() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+void LoopCloser::add(KeyframeInput kf) {
+  if (!threaded_) {
+    process(std::move(kf));
+    return;
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queue_.push_back(std::move(kf));
+  }
+  wake_.notify_one();
+}
+
+void LoopCloser::drain() {
+  if (!threaded_) return;
+  std::unique_lock<std::mutex> lock(mutex_);
+  idle_.wait(lock, [this] { return queue_.empty() && !busy_; });
+}
+
+void LoopCloser::work() {
+  for (;;) {
+    KeyframeInput kf;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // stopping
+      kf = std::move(queue_.front());
+      queue_.pop_front();
+      busy_ = true;
+    }
+    process(std::move(kf));
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      busy_ = false;
+    }
+    idle_.notify_all();
+  }
+}
+
+void LoopCloser::process(KeyframeInput in) {
+  const auto start = std::chrono::steady_clock::now();
+  Keyframe kf;
+  kf.frame = in.frame;
+  kf.odometry = in.odometry;
+  kf.cloud = voxelDownsample(in.points, config_.registration_voxel_m);
+  kf.descriptor = makeScanContext(kf.cloud, sc_params_);
+  const int id = static_cast<int>(keyframes_.size());
+  if (id > 0) {
+    const Keyframe& prev = keyframes_.back();
+    const Pose T_ab = prev.odometry.inverse() * kf.odometry;
+    const double d = T_ab.translation().norm();
+    kf.path_m = prev.path_m + d;
+    // The node starts where the current correction puts it: the previous node's pose times the
+    // odometry's motion.
+    graph_.addNode(graph_.pose(id - 1) * T_ab);
+    Vector6d sigma;
+    const double st = 0.01 + config_.odometry_sigma_t * d, sr = 0.001 + config_.odometry_sigma_r * d;
+    sigma << st, st, st, sr, sr, sr;
+    graph_.addOdometryEdge(id - 1, id, T_ab, sigma);
+  } else {
+    graph_.addNode(kf.odometry);
+  }
+  keyframes_.push_back(std::move(kf));
+  const Keyframe& q = keyframes_.back();
+
+  std::optional<LoopEvent> event;
+  if (config_.enabled && id >= quiet_until_) {
+    const Pose T_q = graph_.pose(id);
+    int best = -1;
+    ScanContextMatch best_match;
+    for (int j = 0; j < id; ++j) {
+      const Keyframe& c = keyframes_[j];
+      if (q.path_m - c.path_m < config_.min_separation_m) break;  // path_m grows with j
+      if ((graph_.pose(j).translation() - T_q.translation()).norm() > config_.search_radius_m) continue;
+      const ScanContextMatch m = compare(q.descriptor, c.descriptor);
+      if (m.distance < best_match.distance) {
+        best_match = m;
+        best = j;
+      }
+    }
+    if (best >= 0 && best_match.distance <= config_.max_descriptor_distance) {
+      const Keyframe& c = keyframes_[best];
+      const Pose prior = graph_.pose(best).inverse() * T_q;
+      LoopEvent e;
+      e.query_keyframe = id;
+      e.match_keyframe = best;
+      e.query_frame = q.frame;
+      e.match_frame = c.frame;
+      e.descriptor_distance = best_match.distance;
+      e.verdict = verifyLoop(q.cloud, c.cloud, prior, q.path_m - c.path_m, config_);
+      if (e.verdict.accepted) {
+        Vector6d sigma;
+        sigma << config_.loop_sigma_t, config_.loop_sigma_t, config_.loop_sigma_t, config_.loop_sigma_r,
+            config_.loop_sigma_r, config_.loop_sigma_r;
+        graph_.addLoopEdge(best, id, e.verdict.registration.T_match_query, sigma);
+        graph_.optimize();
+        // The next loop is looked for a few keyframes on: neighbours of an accepted loop repeat it.
+        quiet_until_ = id + 10;
+      }
+      event = e;
+    }
+  }
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::lock_guard<std::mutex> lock(mutex_);
+  times_ms_.push_back(ms);
+  if (event) {
+    new_events_.push_back(*event);
+    events_.push_back(*event);
+  }
+  if (event && event->verdict.accepted) optimized_ = graph_.poses();
+}
+
+std::optional<std::vector<Pose>> LoopCloser::takeOptimizedPoses() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::optional<std::vector<Pose>> out;
+  out.swap(optimized_);
+  return out;
+}
+
+std::vector<LoopEvent> LoopCloser::takeEvents() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<LoopEvent> out;
+  out.swap(new_events_);
+  return out;
+}
+
+std::vector<LoopEvent> LoopCloser::allEvents() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return events_;
+}
+
+int LoopCloser::accepted() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  int n = 0;
+  for (const LoopEvent& e : events_) n += e.verdict.accepted;
+  return n;
+}
+
+int LoopCloser::rejected() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  int n = 0;
+  for (const LoopEvent& e : events_) n += !e.verdict.accepted;
+  return n;
+}
+
+std::vector<double> LoopCloser::timesMs() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return times_ms_;
+}
+
+}  // namespace dlslot::mapper

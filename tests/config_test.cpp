@@ -63,13 +63,13 @@ TEST(Config, ShippedConfigHasChannels) {
 TEST(Config, PipelineConfigRejectsAMisspeltSection) {
   const std::string ok = writeYaml("cfg_pipe_ok.yaml",
                                    "channels: {scan: A, detections: B, ground_truth: C, odometry: D, associations: E,"
-                                   " slot_state: F, map_state: H, status: G}\ntracker: {}\n");
+                                   " slot_state: F, status: G}\ntracker: {}\n");
   Channels c;
   EXPECT_NO_THROW(loadPipelineConfig(ok, c));
   EXPECT_EQ(c.slot_state, "F");
   const std::string bad = writeYaml("cfg_pipe_bad.yaml",
                                     "channels: {scan: A, detections: B, ground_truth: C, odometry: D, associations: E,"
-                                    " slot_state: F, map_state: H, status: G}\ntrackr: {}\n");
+                                    " slot_state: F, status: G}\ntrackr: {}\n");
   const std::string e = errorOf([&] { loadPipelineConfig(bad, c); });
   EXPECT_NE(e.find("trackr (line 2): unknown key"), std::string::npos) << e;
 }

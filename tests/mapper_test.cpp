@@ -120,7 +120,7 @@ TEST(ScanContext, ShiftedColumnsGiveZeroDistanceAndTheShift) {
 }
 
 TEST(TrackBoxes, MovingTracksAreFollowedThroughMissesAndParkedOnesKeptUnlessMovable) {
-  TrackBoxes boxes(0.25, 5, false), movable(0.25, 5, true);
+  TrackBoxes boxes(0.25, 5, false, 0.1), movable(0.25, 5, true, 0.1);
   auto snapshot = [](int id, double x, bool dynamic) {
     TrackSnapshot s;
     s.id = id;
@@ -141,6 +141,8 @@ TEST(TrackBoxes, MovingTracksAreFollowedThroughMissesAndParkedOnesKeptUnlessMova
   EXPECT_EQ(at2[0].id, 1);
   EXPECT_NEAR(at2[0].center.x(), 20.0, 1e-9);
   EXPECT_NEAR(at2[0].size.x(), 4.5, 1e-9);  // grown by the margin on both ends
+  EXPECT_NEAR(at2[0].size.z(), 1.65, 1e-9);  // and on top; its bottom raised by the clearance
+  EXPECT_NEAR(at2[0].center.z() - 0.5 * at2[0].size.z(), -0.75 + 0.1, 1e-9);
   // Frame 6, two frames after the last sighting: carried at 10 m/s, x = 40 + 2.
   std::vector<Box> at6 = boxes.removalBoxes(6, 0.6);
   ASSERT_EQ(at6.size(), 1u);

@@ -139,7 +139,6 @@ void Channels::read(ConfigSection s) {
   s.get("odometry", odometry);
   s.get("associations", associations);
   s.get("slot_state", slot_state);
-  s.get("map_state", map_state);
   s.get("status", status);
   s.finish();
 }

@@ -101,33 +101,68 @@ void LoopCloser::process(KeyframeInput in) {
   std::optional<LoopEvent> event;
   if (config_.enabled && id >= quiet_until_) {
     const Pose T_q = graph_.pose(id);
-    int best = -1;
+    // Two ways to a candidate: the best Scan Context among the keyframes near the current
+    // estimate (a place seen again from anywhere on it), and the nearest keyframe by position
+    // (LIO-SAM's radius search: a place passed again tens of metres away, where an egocentric
+    // descriptor no longer matches but the scans still overlap). Both lie at least
+    // min_separation_m back along the path; the descriptor's one is verified first.
+    int best = -1, nearest = -1;
     ScanContextMatch best_match;
+    double nearest_m = config_.search_radius_m;
     for (int j = 0; j < id; ++j) {
       const Keyframe& c = keyframes_[j];
       if (q.path_m - c.path_m < config_.min_separation_m) break;  // path_m grows with j
-      if ((graph_.pose(j).translation() - T_q.translation()).norm() > config_.search_radius_m) continue;
+      const double d = (graph_.pose(j).translation() - T_q.translation()).norm();
+      if (d > config_.search_radius_m) continue;
+      if (d <= nearest_m) {
+        nearest_m = d;
+        nearest = j;
+      }
       const ScanContextMatch m = compare(q.descriptor, c.descriptor);
       if (m.distance < best_match.distance) {
         best_match = m;
         best = j;
       }
     }
-    if (best >= 0 && best_match.distance <= config_.max_descriptor_distance) {
-      const Keyframe& c = keyframes_[best];
-      const Pose prior = graph_.pose(best).inverse() * T_q;
+    if (!(best >= 0 && best_match.distance <= config_.max_descriptor_distance)) best = -1;
+    // A nearest-keyframe candidate is verified once every few keyframes (the query moves on by
+    // metres between them; verification is the costly part).
+    const int candidate = best >= 0 ? best : (nearest >= 0 && id % 5 == 0 ? nearest : -1);
+    if (candidate >= 0) {
+      const Keyframe& c = keyframes_[candidate];
+      const Pose T_c = graph_.pose(candidate);
+      const Pose prior = T_c.inverse() * T_q;
+      // The match side is a local map: the candidate and its neighbours in its frame.
+      const int lo = std::max(0, candidate - config_.submap_keyframes), hi = std::min(id - 1, candidate + config_.submap_keyframes);
+      std::vector<PointCloud> parts;
+      Eigen::Index n = 0;
+      for (int j = lo; j <= hi; ++j) {
+        if (q.path_m - keyframes_[j].path_m < config_.min_separation_m) break;
+        const Pose T_cj = T_c.inverse() * graph_.pose(j);
+        PointCloud part = keyframes_[j].cloud;
+        for (Eigen::Index i = 0; i < part.cols(); ++i) part.col(i).head<3>() = (T_cj * part.col(i).head<3>().cast<double>()).cast<float>();
+        n += part.cols();
+        parts.push_back(std::move(part));
+      }
+      PointCloud submap(4, n);
+      n = 0;
+      for (const PointCloud& part : parts) {
+        submap.middleCols(n, part.cols()) = part;
+        n += part.cols();
+      }
+      submap = voxelDownsample(submap, config_.registration_voxel_m);
       LoopEvent e;
       e.query_keyframe = id;
-      e.match_keyframe = best;
+      e.match_keyframe = candidate;
       e.query_frame = q.frame;
       e.match_frame = c.frame;
-      e.descriptor_distance = best_match.distance;
-      e.verdict = verifyLoop(q.cloud, c.cloud, prior, q.path_m - c.path_m, config_);
+      e.descriptor_distance = compare(q.descriptor, c.descriptor).distance;
+      e.verdict = verifyLoop(q.cloud, submap, prior, q.path_m - c.path_m, config_);
       if (e.verdict.accepted) {
         Vector6d sigma;
         sigma << config_.loop_sigma_t, config_.loop_sigma_t, config_.loop_sigma_t, config_.loop_sigma_r,
             config_.loop_sigma_r, config_.loop_sigma_r;
-        graph_.addLoopEdge(best, id, e.verdict.registration.T_match_query, sigma);
+        graph_.addLoopEdge(candidate, id, e.verdict.registration.T_match_query, sigma);
         graph_.optimize();
         // The next loop is looked for a few keyframes on: neighbours of an accepted loop repeat it.
         quiet_until_ = id + 10;

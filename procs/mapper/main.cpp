@@ -124,7 +124,7 @@ int runLive(const MapperConfig& config, const Channels& channels, const NodeOpti
         const int64_t utime = j.b->utime;
         j.b->scan = std::move(*j.a);
         mapper.add(*j.b);
-        node.publish(channels.map_state, mapStateMsg(mapper, j.frame, utime, slot_pose, mapper.loops().takeEvents()));
+        node.publish(config.channel, mapStateMsg(mapper, j.frame, utime, slot_pose, mapper.loops().takeEvents()));
         node.status().frameDone(j.frame, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         node.status().set("keyframes", static_cast<int64_t>(mapper.keyframes().size()));
         node.status().set("map_voxels", static_cast<int64_t>(mapper.map().size()));

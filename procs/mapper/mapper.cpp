@@ -7,7 +7,7 @@ namespace dlslot::mapper {
 
 Mapper::Mapper(const MapperConfig& config, bool threaded)
     : config_(config),
-      boxes_(config.box_margin_m, config.follow_frames, config.remove_movable),
+      boxes_(config.box_margin_m, config.follow_frames, config.remove_movable, config.ground_clearance_m),
       map_(config.map_voxel_m),
       removed_(config.map_voxel_m),
       loops_(std::make_unique<LoopCloser>(config.loop, threaded)) {}

@@ -4,8 +4,8 @@
 
 namespace dlslot::mapper {
 
-TrackBoxes::TrackBoxes(double margin_m, int follow_frames, bool movable)
-    : margin_(margin_m), follow_(follow_frames), movable_(movable) {}
+TrackBoxes::TrackBoxes(double margin_m, int follow_frames, bool movable, double clearance_m)
+    : margin_(margin_m), clearance_(clearance_m), follow_(follow_frames), movable_(movable) {}
 
 void TrackBoxes::add(int frame, double stamp_s, const std::vector<TrackSnapshot>& tracks) {
   for (const TrackSnapshot& t : tracks) {
@@ -44,7 +44,9 @@ std::vector<Box> TrackBoxes::removalBoxes(int frame, double stamp_s) const {
       }
     }
     if (!box) continue;
-    box->size += Eigen::Vector3d::Constant(2 * margin_);
+    // Grown by the margin on every side but the bottom, which is raised by the clearance.
+    box->size += Eigen::Vector3d(2 * margin_, 2 * margin_, margin_ - clearance_);
+    box->center.z() += 0.5 * (margin_ + clearance_);
     box->id = id;
     out.push_back(*box);
   }

@@ -25,7 +25,9 @@ class TrackBoxes {
  public:
   // margin: growth of every box on each side; follow_frames: the longest gap bridged;
   // movable: every track is removed, not only the moving ones.
-  TrackBoxes(double margin_m, int follow_frames, bool movable);
+  // clearance: the removal box starts this far above the box's bottom, so the road under and
+  // around a car stays in the map (a road voxel is often hit only while a car is beside it).
+  TrackBoxes(double margin_m, int follow_frames, bool movable, double clearance_m = 0.0);
 
   void add(int frame, double stamp_s, const std::vector<TrackSnapshot>& tracks);
   // The grown world-frame boxes of the objects to remove at `frame` (stamp_s its time): every
@@ -46,7 +48,7 @@ class TrackBoxes {
     bool ever_dynamic = false;
     std::map<int, Sighting> seen;  // frame -> box where the track was observed
   };
-  double margin_;
+  double margin_, clearance_;
   int follow_;
   bool movable_;
   std::map<int, History> tracks_;

@@ -26,6 +26,8 @@ struct MapMetrics {
   std::optional<int> loops_false;  // null without ground-truth poses
   int keyframes = 0;
   int64_t map_points = 0;
+  // |t| of (first^-1 last) minus the truth's, for the map trajectory and for SLOT's.
+  std::optional<double> end_to_start_m, slot_end_to_start_m;
 };
 
 struct RunData {

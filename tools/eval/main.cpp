@@ -271,6 +271,16 @@ void addMap(const Options& o, const DataSet& data, RunData& run) {
   }
   mm.loops_accepted = accepted;
   if (!truth_pose.empty()) mm.loops_false = wrong;
+  // End-to-start: how far the last scan's pose relative to the first is from the truth's (what a
+  // loop that returns to its start must get right).
+  auto endToStart = [&](const Trajectory& t) -> std::optional<double> {
+    if (t.size() < 2 || !truth_pose.count(t.frames.front()) || !truth_pose.count(t.frames.back())) return std::nullopt;
+    const Pose est = t.poses.front().inverse() * t.poses.back();
+    const Pose gt = truth_pose[t.frames.front()].inverse() * truth_pose[t.frames.back()];
+    return (est.translation() - gt.translation()).norm();
+  };
+  mm.end_to_start_m = endToStart(run.sources["map"]);
+  if (run.sources.count("slot")) mm.slot_end_to_start_m = endToStart(run.sources["slot"]);
   // The map.
   pcl::PointCloud<pcl::PointXYZI> cloud;
   const std::string pcd = (dir / "map.pcd").string();

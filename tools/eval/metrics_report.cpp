@@ -253,6 +253,8 @@ std::string metricsJson(const Metrics& m) {
     kv.emplace_back("map.points", std::to_string(m.map->map_points));
     kv.emplace_back("map.loops_accepted", std::to_string(m.map->loops_accepted));
     kv.emplace_back("map.loops_false", m.map->loops_false ? std::to_string(*m.map->loops_false) : "null");
+    kv.emplace_back("map.end_to_start_m", num(m.map->end_to_start_m));
+    kv.emplace_back("map.slot_end_to_start_m", num(m.map->slot_end_to_start_m));
   }
   std::string out = "{\n";
   for (size_t i = 0; i < kv.size(); ++i)

@@ -74,7 +74,6 @@ struct Channels {
   std::string odometry = "ODOMETRY";
   std::string associations = "ASSOCIATIONS";
   std::string slot_state = "SLOT_STATE";
-  std::string map_state = "MAP_STATE";
   std::string status = "PROCESS_STATUS";
   void read(ConfigSection section);
 };

@@ -270,10 +270,8 @@ TEST(Mapper, AMovingCarLeavesNoGhostAndTheStaticWorldStays) {
     for (double x = -20; x <= 20; x += 0.1)
       for (double z = -1.5; z <= 1.0; z += 0.25) pts.emplace_back(x, 10 - 0.0, z);  // wall, lidar frame (ego moves along x)
     const double car_x = 5.0 + f * 2.0 - f * 1.0;  // the car, 1 m/s faster than the ego, 5 m ahead, lidar frame
-    for (double dx = -2; dx <= 2; dx += 0.1)
-      for (double dz = -0.7; dz <= 0.7; dz += 0.1) pts.emplace_back(car_x + dx, -3.5, dz - 1.0);
-    for (Eigen::Vector3d& p : pts) p.x() -= 0.0;
-    std::vector<Eigen::Vector3d> world_shift;  // points are given in the lidar frame
+    for (double dx = -2; dx <= 2; dx += 0.1)  // the body 0.15 m above the box's floor (wheels), to its top
+      for (double dz = -0.6; dz <= 0.7; dz += 0.1) pts.emplace_back(car_x + dx, -3.5, dz - 1.0);
     in.scan = toCloud(pts);
     if (f % 4 != 2) {  // detector misses every fourth frame
       TrackSnapshot t;

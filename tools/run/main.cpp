@@ -9,7 +9,11 @@
 // everything cleanly, runs the evaluator, and accounts for every played frame per process
 // (frame_accounting.hpp): a run that lost frames says so in its last line and exits 4 unless
 // --allow-loss. Run it inside scripts/netns-run (./dlslot run does) unless --lcm-url is given.
+// --foxglove [PORT] also starts dlslot-foxglove, the live Foxglove bridge (not counted in the
+// frame accounting: it only watches).
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -78,14 +82,48 @@ int runToEnd(run::Supervisor& sup, const std::string& name, const std::vector<st
   return sup.stop(name);
 }
 
+// The 1-minute load average (-1 when unknown): a wall-clock rate means little without it.
+double loadAverage() {
+  std::ifstream in("/proc/loadavg");
+  double load = -1;
+  in >> load;
+  return in ? load : -1;
+}
+
+// OUT/speed.yaml: what `./dlslot bench` compares with bench/baseline.yaml (dlslot-bench-check).
+void writeSpeed(const std::string& path, const std::vector<std::pair<std::string, double>>& cpu_ms, double rate,
+                double load_before, double load_after) {
+  std::ofstream f(path);
+  f << "# dlslot-run: CPU time per played frame of each process (ms), the pipeline rate (frames/s)\n"
+    << "# and the 1-minute load average at the start and the end of the play.\n";
+  f << "rate_fps: " << rate << "\nload: [" << load_before << ", " << load_after << "]\ncpu_ms_per_frame:\n";
+  for (const auto& [p, ms] : cpu_ms) f << "  " << p << ": " << ms << "\n";
+  if (!f) throw std::runtime_error("cannot write " + path);
+}
+
 struct Failure : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// "--foxglove" may come without its port: the default port is put in, so the option parser
+// (which wants a value) sees "--foxglove 8765".
+std::vector<std::string> withFoxglovePort(int argc, char** argv) {
+  std::vector<std::string> a(argv, argv + argc);
+  for (size_t i = 1; i < a.size(); ++i)
+    if (a[i] == "--foxglove" && (i + 1 == a.size() || a[i + 1].rfind("--", 0) == 0)) a.insert(a.begin() + i + 1, "8765");
+  return a;
+}
+
 int runPipeline(int argc, char** argv) {
+  std::vector<std::string> arg_text = withFoxglovePort(argc, argv);
+  std::vector<char*> arg_ptrs;
+  for (auto& a : arg_text) arg_ptrs.push_back(a.data());
+  argc = static_cast<int>(arg_ptrs.size());
+  argv = arg_ptrs.data();
+  int foxglove_port = -1;
   std::string root, sequence = "0000", scenario, mode = "slot", config = "config/dlslot.yaml", out, lcm_url, detector;
   std::vector<std::string> detections;
-  int frames = -1, seed = 1;
+  int frames = -1, seed = 1, in_flight = 2;
   double speed = 0, stall_s = 60, start_timeout_s = 30, heartbeat_s = 10;
   bool no_eval = false, no_render = false, no_map = false, quiet = false, allow_loss = false;
   CommandLine cl("dlslot-run", "Runs player, odometry, tracker, backend, renderer and lcm-logger on one sequence.");
@@ -106,13 +144,20 @@ int runPipeline(int argc, char** argv) {
   cl.option("--stall-timeout", &stall_s, "seconds without progress before the run fails (default 60)");
   cl.option("--heartbeat-timeout", &heartbeat_s,
             "seconds without a process's PROCESS_STATUS before it counts as stalled and the run fails (default 10)");
+  cl.option("--in-flight", &in_flight,
+            "lockstep: frames the player keeps ahead of SLOT_STATE (default 2: the odometry of t+1 overlaps the "
+            "backend's t, same results; 1: strict lockstep)");
   cl.flag("--allow-loss", &allow_loss, "exit 0 even when frames were lost (they are still reported)");
   cl.flag("--no-eval", &no_eval, "skip the evaluation");
   cl.flag("--no-render", &no_render, "do not start the renderer");
   cl.flag("--no-map", &no_map, "do not start the mapper (no map.pcd, map.png, trajectory_map_*)");
   cl.flag("--quiet", &quiet, "no progress line");
+  cl.option("--foxglove", &foxglove_port,
+            "[PORT] also serve the live run to Foxglove (dlslot-foxglove, WebSocket on 127.0.0.1:PORT, default 8765)");
   if (!cl.parse(argc, argv)) return 0;
+  const bool foxglove = foxglove_port >= 0;
   if (out.empty()) throw std::invalid_argument("--out DIR is required");
+  if (in_flight < 1) throw std::invalid_argument("--in-flight: expected an integer >= 1");
   config = fs::absolute(findConfigFile(config)).string();  // the children get the same file from any directory
   if (root.empty() == scenario.empty()) throw std::invalid_argument("give either --kitti ROOT or --scenario NAME");
   const ModeSettings ms = settingsFor(mode);
@@ -129,8 +174,10 @@ int runPipeline(int argc, char** argv) {
     ConfigSection cfg = loadConfig(config);  // throws a clear ConfigError
     (void)cfg;
     fs::copy_file(config, out + "/config.yaml", fs::copy_options::overwrite_existing);
-    for (const std::string p : {"player", "detector", "odometry", "tracker", "backend", "renderer", "mapper"}) {
-      if ((no_render && p == "renderer") || (!geometric && p == "detector") || (no_map && p == "mapper")) continue;
+    for (const std::string p : {"player", "detector", "odometry", "tracker", "backend", "renderer", "mapper", "foxglove"}) {
+      if ((no_render && p == "renderer") || (!geometric && p == "detector") || (!foxglove && p == "foxglove") ||
+          (no_map && p == "mapper"))
+        continue;
       const std::string log = logs + "/check-" + p + ".log";
       if (runToEnd(sup, "check-" + p, {bin + "/dlslot-" + p, "--config", config, "--check-config"}, log) != 0)
         throw ConfigError("dlslot-" + p + " refused the config:\n" + run::readText(log));
@@ -180,11 +227,31 @@ int runPipeline(int argc, char** argv) {
     sup.start("mapper", args(bin + "/dlslot-mapper", {"--out", out}), logs + "/mapper.log");
   }
   sup.start("backend", args(bin + "/dlslot-backend", {"--mode", ms.backend}), logs + "/backend.log");
-  sup.start("tracker", args(bin + "/dlslot-tracker", {}), logs + "/tracker.log");
+  // Lockstep with two frames in flight: the player publishes frame t+1 once SLOT_STATE carried
+  // t-1, so the odometry of t+1 runs while the tracker and the backend finish t, and the tracker
+  // waits for SLOT_STATE t before associating t+1 (slot_state_gate.hpp): every process sees its
+  // inputs in frame order and the tracker the optimized poses of strict lockstep, so the results
+  // are the same bytes (pipeline_overlap test). --in-flight 1: strict lockstep.
+  sup.start("tracker", args(bin + "/dlslot-tracker", speed > 0 ? std::vector<std::string>{}
+                                                                  : std::vector<std::string>{"--follow-slot-state"}),
+            logs + "/tracker.log");
   sup.start("odometry", args(bin + "/dlslot-odometry", {"--mode", ms.odometry}), logs + "/odometry.log");
   if (geometric) {
     pipeline.push_back("detector");
     sup.start("detector", args(bin + "/dlslot-detector", {}), logs + "/detector.log");
+  }
+  // The frames every pipeline process must account for; the bridge only watches.
+  const std::vector<std::string> accounted(pipeline.rbegin(), pipeline.rend());
+  if (foxglove) {
+    pipeline.push_back("foxglove");
+    sup.start("foxglove", args(bin + "/dlslot-foxglove", {"--port", std::to_string(foxglove_port)}),
+              logs + "/foxglove.log");
+    std::cerr << "foxglove: live bridge on ws://127.0.0.1:" << foxglove_port << " (Foxglove: Open connection -> "
+              << "Foxglove WebSocket)";
+    if (const char* ns = std::getenv("DLSLOT_NETNS"); ns && std::string(ns) == "private")
+      std::cerr << "; it is inside this run's private network namespace: to reach it from this machine give "
+                   "--lcm-url 'udpm://239.255.76.67:7667?ttl=0'";
+    std::cerr << "\n";
   }
 
   std::map<std::string, process_status_t> health;
@@ -250,9 +317,10 @@ int runPipeline(int argc, char** argv) {
   if (speed > 0)
     play.insert(play.end(), {"--speed", std::to_string(speed)});
   else
-    play.insert(play.end(), {"--lockstep", "SLOT_STATE"});
+    play.insert(play.end(), {"--lockstep", "SLOT_STATE", "--in-flight", std::to_string(in_flight)});
   sup.start("player", args(bin + "/dlslot-player", play), logs + "/player.log");
   const auto play_start = Node::Clock::now();
+  const double load_before = loadAverage();
   ProgressLine progress("run " + (scenario.empty() ? sequence : scenario) + " [" + mode + "]", last_frame + 1);
   last_progress = Node::Clock::now();
   auto healthText = [&] {
@@ -294,37 +362,44 @@ int runPipeline(int argc, char** argv) {
   // logger closes the log).
   // The launcher keeps reading while it waits, so each process's last PROCESS_STATUS is heard.
   const auto listen = [&] { node.spinUntil([] { return false; }, 0.02); };
-  for (const std::string p : {"detector", "odometry", "tracker", "backend", "mapper", "renderer"}) {
+  for (const std::string p : {"detector", "odometry", "tracker", "backend", "mapper", "renderer", "foxglove"}) {
     if ((p == std::string("renderer") && no_render) || (p == std::string("detector") && !geometric) ||
-        (p == std::string("mapper") && no_map))
+        (p == std::string("foxglove") && !foxglove) || (p == std::string("mapper") && no_map))
       continue;
     // The mapper finishes its keyframes and loop closure and writes the map files before it exits.
-    const double grace = p == std::string("renderer") || p == std::string("mapper") ? 120.0 : 10.0;
+    const double grace = p == std::string("renderer") ? 60.0 : p == std::string("mapper") ? 120.0 : 10.0;
     const int code = sup.stop(p, grace, listen);
     if (code != 0) throw Failure(p + " did not exit cleanly (code " + std::to_string(code) + "):\n" + sup.tail(p));
   }
   node.spinUntil([] { return false; }, 0.3);
   sup.stop("lcm-logger");
   // Where the two cores went: each process's CPU time over the whole run, per played frame.
+  std::vector<std::pair<std::string, double>> cpu_ms;
   {
     std::string line;
-    for (const std::string p : {"odometry", "tracker", "backend", "mapper", "renderer", "player", "lcm-logger"}) {
-      if ((p == std::string("renderer") && no_render) || (p == std::string("mapper") && no_map)) continue;
+    for (const std::string p : {"odometry", "detector", "tracker", "backend", "mapper", "renderer", "foxglove", "player",
+                                "lcm-logger"}) {
+      if ((p == std::string("renderer") && no_render) || (p == std::string("foxglove") && !foxglove) ||
+          (p == std::string("detector") && !geometric) || (p == std::string("mapper") && no_map))
+        continue;
       const double s = sup.cpuSeconds(p);
       if (s < 0) continue;
+      cpu_ms.emplace_back(p, 1e3 * s / (last_frame + 1));
       char buf[96];
-      std::snprintf(buf, sizeof buf, "%s%s %.1f ms", line.empty() ? "" : ", ", p.c_str(), 1e3 * s / (last_frame + 1));
+      std::snprintf(buf, sizeof buf, "%s%s %.1f ms", line.empty() ? "" : ", ", p.c_str(), cpu_ms.back().second);
       line += buf;
     }
     std::fprintf(stderr, "CPU per frame: %s\n", line.c_str());
   }
   // The pipeline rate: from the player's start (less its start-up delay) to the last SLOT_STATE.
   const double play_s = std::chrono::duration<double>(last_slot_time - play_start).count() - 0.2;
+  const double rate = play_s > 0 ? slot_frames / play_s : 0.0;
   std::fprintf(stderr, "SLOT_STATE for %d of %d frames; pipeline rate %.2f frames/s (%s)\n", slot_frames,
-               last_frame + 1, play_s > 0 ? slot_frames / play_s : 0.0, speed > 0 ? "rate mode" : "lockstep");
+               last_frame + 1, rate, speed > 0 ? "rate mode" : "lockstep");
+  writeSpeed(out + "/speed.yaml", cpu_ms, rate, load_before, loadAverage());
   if (slot_frames != last_frame + 1) std::cerr << "warning: frames are missing from SLOT_STATE\n";
   // Where every frame went, and the memory of each process over the run.
-  FrameAccounting accounting = accountFrames(health, last_frame + 1, std::vector<std::string>(pipeline.rbegin(), pipeline.rend()));
+  FrameAccounting accounting = accountFrames(health, last_frame + 1, accounted);
   if (const int64_t after = udpReceiveBufferErrors(); after >= 0 && kernel_drops_before >= 0)
     accounting.kernel_drops = std::max(accounting.kernel_drops, after - kernel_drops_before);  // the logger's too
   std::cerr << accounting.table();
@@ -353,7 +428,7 @@ int runPipeline(int argc, char** argv) {
     if (runToEnd(sup, "eval", eval, logs + "/eval.log") != 0) throw Failure("dlslot-eval failed:\n" + sup.tail("eval", 30));
     std::cout << run::readText(logs + "/eval.log");
   }
-  std::cout << "outputs in " << out << ": run.lcmlog, trajectory_*.txt, tracks_kitti.txt, metrics.json, report.md, "
+  std::cout << "outputs in " << out << ": run.lcmlog, speed.yaml, trajectory_*.txt, tracks_kitti.txt, metrics.json, report.md, "
             << (no_render ? "" : "bev/, ") << (no_map ? "" : "map.pcd, map_removed.pcd, map.png, ")
             << "plots/, config.yaml, logs/\n";
   std::cout << std::flush;

@@ -1,9 +1,11 @@
 #include "dlslot/node.hpp"
 
 #include <poll.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <csignal>
 #include <cstdlib>
@@ -15,6 +17,7 @@
 
 #include "dlslot/frame_accounting.hpp"
 #include "dlslot/input_error.hpp"
+#include "dlslot/large_message_filter.hpp"
 #include "dlslot/receive_buffer.hpp"
 
 namespace dlslot {
@@ -114,12 +117,56 @@ void NodeOptions::addTo(CommandLine& cl) {
 
 // ---------------- ProcessStatus ----------------
 
+namespace {
+
+double processCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+// DLSLOT_SLOWDOWN=NAME:FRACTION[,NAME:FRACTION...]: the fraction of extra CPU time the process
+// named NAME burns per frame (0 when not named or malformed).
+double slowdownFor(const std::string& name) {
+  const char* env = std::getenv("DLSLOT_SLOWDOWN");
+  if (!env) return 0;
+  for (const std::string& item : splitList(env)) {
+    const size_t colon = item.find(':');
+    if (colon == std::string::npos || item.substr(0, colon) != name) continue;
+    char* end = nullptr;
+    const double f = std::strtod(item.c_str() + colon + 1, &end);
+    if (end && *end == '\0' && f > 0 && f < 100) return f;
+    std::fprintf(stderr, "[%s] DLSLOT_SLOWDOWN: '%s' is not NAME:FRACTION; ignored\n", name.c_str(), item.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
 ProcessStatus::ProcessStatus(std::string name) : name_(std::move(name)) {}
 
 void ProcessStatus::frameDone(int frame, double ms) {
   ++frames_;
   last_frame_ = frame;
   times_.add(ms);
+  // Test hook of the speed guard (./dlslot bench, docs/performance.md): DLSLOT_SLOWDOWN=NAME:FRACTION
+  // makes the process whose (first) status is NAME burn that fraction of its CPU time since the
+  // previous frame (every thread's) in a loop, so its CPU per frame grows by the fraction.
+  static const double slowdown = [this] {
+    const double f = slowdownFor(name_);
+    if (f > 0)
+      std::fprintf(stderr, "[%s] DLSLOT_SLOWDOWN: burning %.0f %% more CPU time per frame (a test of the speed guard)\n",
+                   name_.c_str(), 100 * f);
+    return f;
+  }();
+  static double cpu_at_last_frame = processCpuSeconds();
+  if (slowdown > 0) {
+    const double now = processCpuSeconds();
+    const double until = now + slowdown * (now - cpu_at_last_frame);
+    volatile double sink = 0;
+    while (processCpuSeconds() < until) sink = sink + 1;
+    cpu_at_last_frame = processCpuSeconds();
+  }
 }
 
 void ProcessStatus::decodeError(const std::string& channel) {
@@ -227,20 +274,48 @@ Node::Node(std::string name, const std::string& lcm_url, const Channels& channel
                              (lcm_url.empty() ? std::string("(default)") : lcm_url) + "'");
   const char* env = std::getenv("LCM_DEFAULT_URL");
   const std::string url = !lcm_url.empty() ? lcm_url : env ? env : "";
-  if (const int64_t want = requestedReceiveBuffer(url); want > 0) {
-    lcm_.getFileno();  // creates LCM's receive socket (it is otherwise made on first use)
-    const ReceiveBuffer rb = enlargeLcmReceiveBuffer(lcmPort(url), want);
-    recv_fd_ = rb.fd;
-    status_.set("recv_buffer_bytes", rb.granted);
-    std::fprintf(stderr, "[%s] %s\n", name_.c_str(), rb.note.c_str());
+  if (const int port = lcmPort(url); port > 0) {
+    // LCM's receive socket is the one that appears when LCM makes it (on first use): any other on
+    // the port was inherited (dlslot-run's children hold the launcher's, a test's launcher the
+    // test's), and a filter or buffer size set on it would act on the other process's socket.
+    const std::vector<int> before = udpSocketsOnPort(port);
+    lcm_.getFileno();
+    for (const int fd : udpSocketsOnPort(port))
+      if (std::find(before.begin(), before.end(), fd) == before.end()) recv_fd_ = fd;
   }
+  if (recv_fd_ >= 0) {
+    if (const int64_t want = requestedReceiveBuffer(url); want > 0) {
+      const ReceiveBuffer rb = enlargeReceiveBuffer(recv_fd_, want);
+      status_.set("recv_buffer_bytes", rb.granted);
+      std::fprintf(stderr, "[%s] %s\n", name_.c_str(), rb.note.c_str());
+    }
+    // No subscription yet, so no point cloud is wanted until one subscribes to the scan channel.
+    filtering_large_ = attachLargeMessageFilter(recv_fd_);
+  }
+}
+
+void Node::noteSubscription(const std::string& channel) {
+  if (channel == channels_.scan && filtering_large_) filtering_large_ = !detachLargeMessageFilter(recv_fd_);
 }
 
 void Node::noteFrameReceived(int frame) {
   if (frames_received_.insert(frame).second) status_.count("frames_received");
 }
 
+void Node::checkSize(const std::string& channel, int64_t bytes) {
+  if (bytes >= kLargeMessageBytes)
+    status_.error("a message on " + channel + " is " + std::to_string(bytes) +
+                  " bytes: processes that take no scans do not receive messages of " +
+                  std::to_string(kLargeMessageBytes) + " bytes or more (large_message_filter.hpp)");
+}
+
+void Node::publishEncoded(const std::string& channel, const void* data, size_t size) {
+  if (channel != channels_.scan) checkSize(channel, static_cast<int64_t>(size));
+  if (lcm_.publish(channel, data, static_cast<unsigned>(size)) != 0) status_.error("publish on " + channel + " failed");
+}
+
 void Node::subscribeRaw(const std::string& channel, RawHandler cb) {
+  noteSubscription(channel);
   handlers_.push_back(std::move(cb));
   lcm_.subscribeFunction<RawHandler*>(
       channel, [](const lcm::ReceiveBuffer* rbuf, const std::string&, RawHandler* h) { (*h)(*rbuf); },
@@ -270,7 +345,9 @@ void Node::handleOnce(double max_wait_s) {
   double wait = max_wait_s;
   for (const Timer& t : timers_) wait = std::min(wait, std::chrono::duration<double>(t.next - now).count());
   pollfd pfd{lcm_.getFileno(), POLLIN, 0};
-  int timeout_ms = std::max(0, static_cast<int>(wait * 1000.0));
+  // Rounded up: rounded down, the last millisecond before every timer was a loop of poll(0)
+  // calls (the backend's 10 ms timer kept a fifth of its CPU time in poll).
+  const int timeout_ms = std::max(0, static_cast<int>(std::ceil(wait * 1000.0)));
   if (poll(&pfd, 1, timeout_ms) > 0 && (pfd.revents & POLLIN)) lcm_.handle();
 
   now = Clock::now();

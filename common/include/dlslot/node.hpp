@@ -115,8 +115,11 @@ class Node {
   void subscribeFrames(const std::string& channel, std::function<void(const Msg&)> cb);
   template <class Msg>
   void publish(const std::string& channel, const Msg& msg) {
+    if (channel != channels_.scan) checkSize(channel, msg.getEncodedSize());
     if (lcm_.publish(channel, &msg) != 0) status_.error("publish on " + channel + " failed");
   }
+  // Publishes bytes already encoded (e.g. encodeScan's).
+  void publishEncoded(const std::string& channel, const void* data, size_t size);
 
   // Calls cb every period_s seconds from the loop.
   void every(double period_s, std::function<void()> cb);
@@ -134,6 +137,10 @@ class Node {
  private:
   void handleOnce(double max_wait_s);
   void noteFrameReceived(int frame);
+  void noteSubscription(const std::string& channel);
+  // A message this large on a channel other than the scan is trimmed away by the large-message
+  // filter of every process that takes no scans (large_message_filter.hpp): reported as an error.
+  void checkSize(const std::string& channel, int64_t bytes);
   struct Timer {
     Clock::time_point next;
     double period_s;  // 0 = one-shot
@@ -147,6 +154,7 @@ class Node {
   std::map<std::string, FrameOrder> frame_order_;
   std::set<int> frames_received_;  // distinct frames that any frame channel carried
   int recv_fd_ = -1;               // LCM's receive socket, for its kernel drop count
+  bool filtering_large_ = false;    // the large-message filter is on recv_fd_ (no scan subscription)
   std::list<RawHandler> handlers_;  // stable addresses: LCM keeps a pointer to each
   bool stop_ = false;
 };

@@ -45,11 +45,13 @@ TEST(PipelineInput, A32BeamPcdFolderRunsThroughTheWholePipeline) {
   EXPECT_EQ(cfg["odometry"]["features"]["num_beams"].as<int>(), 32);
   EXPECT_NEAR(cfg["odometry"]["features"]["max_vertical_deg"].as<double>(), 10.67, 1e-9);
   const auto events = readLog(out + "/run.lcmlog");
-  EXPECT_EQ(decodeAll<slot_state_t>(events.at("SLOT_STATE")).size(), static_cast<size_t>(kFrames));
-  // Ground truth from poses.txt through the extrinsics: the metrics are against it.
+  const auto states = decodeAll<slot_state_t>(events.at("SLOT_STATE"));
+  ASSERT_EQ(states.size(), static_cast<size_t>(kFrames));
+  EXPECT_GT(states.back().num_tracks, 0);  // the detections (camera coordinates, camera_calib) were tracked
+  // Ground truth from poses.txt through the extrinsics: the ego metrics are against it (a folder
+  // has no labelled boxes, so no tracking metrics).
   const YAML::Node m = YAML::LoadFile(out + "/metrics.json");
-  EXPECT_LT(m["ego.ate_rmse_m"].as<double>(), 1.0);
-  EXPECT_GT(m["tracking.mota"].as<double>(), 0.3);
+  EXPECT_LT(m["ego.ate_rmse_m"].as<double>(), 0.5);
 }
 
 TEST(PipelineInput, ABadCalibrationIsRefusedNamingTheFileAndKey) {

@@ -228,7 +228,7 @@ Refusal checkLayout(const point_cloud_t*, const void* data, size_t size) {
 
 Refusal checkLayout(const detections_t*, const void* data, size_t size) {
   Cursor c(data, size);
-  (void)(header(c, detections_t::getHash()) && c.str("source") && boxes(c, "num_boxes"));
+  (void)(header(c, detections_t::getHash()) && c.str("source") && boxes(c, "num_boxes") && timings(c));
   return c.finish();
 }
 
@@ -295,7 +295,7 @@ Refusal checkContent(const point_cloud_t& m) {
 Refusal checkContent(const detections_t& m) {
   if (Refusal r = checkFrame(m.frame)) return r;
   if (Refusal r = checkUtime(m.utime)) return r;
-  return {};  // boxes: refused one by one by the consumers (rejected_detections)
+  return checkTimings(m.timings);  // boxes: refused one by one by the consumers (rejected_detections)
 }
 
 Refusal checkContent(const ground_truth_t& m) {

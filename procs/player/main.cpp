@@ -140,7 +140,7 @@ int run(int argc, char** argv) {
     node.publishEncoded(channels.scan, scan_bytes.data(), scan_bytes.size());
 
     if (!no_detections) {
-      detections_t det;
+      detections_t det{};
       det.utime = frame.utime;
       det.frame = frame.index;
       det.boxes = toMsg(frame.detections);

@@ -486,6 +486,9 @@ int runPipeline(int argc, char** argv) {
   }
   std::cout << "outputs in " << out << ": run.lcmlog, speed.yaml, trajectory_*.txt, tracks_kitti.txt, metrics.json, report.md, "
             << (no_render ? "" : "bev/, ") << "plots/, config.yaml, logs/\n";
+  std::cout << "to look at it: report.md has every table; " << (no_render ? "" : "bev/ one bird's-eye image a frame "
+            "(points, boxes coloured by track with id and speed, the trajectories; any image viewer), ")
+            << "plots/ the trajectories and their errors\n";
   std::cout << std::flush;
   std::cerr << "dlslot-run: " << accounting.verdict() << "\n";
   if (accounting.hasLoss() && !allow_loss) return 4;

@@ -643,6 +643,15 @@ bool classesCompatible(const std::string& a, const std::string& b) {
 
 // ---------------- SequenceReader ----------------
 
+std::vector<LabelRow> readDetectionRows(const std::string& path) {
+  std::ifstream in = openText(path);
+  std::string first;
+  while (std::getline(in, first) && first.find_first_not_of(" \t\r") == std::string::npos) {
+  }
+  const bool csv = first.find(',') != std::string::npos;
+  return csv ? readCsvDetections(path) : readTrackingLabels(path);
+}
+
 SequenceReader::SequenceReader(const std::string& root, const std::string& sequence,
                                const std::vector<std::string>& detection_paths, double min_detection_score,
                                double frame_period_s)
@@ -651,12 +660,7 @@ SequenceReader::SequenceReader(const std::string& root, const std::string& seque
   std::vector<std::vector<LabelRow>> detection_rows;
   for (std::string path : detection_paths) {
     if (fs::is_directory(path)) path = (fs::path(path) / (sequence + ".txt")).string();
-    std::ifstream in = openText(path);
-    std::string first;
-    while (std::getline(in, first) && first.find_first_not_of(" \t\r") == std::string::npos) {
-    }
-    const bool csv = first.find(',') != std::string::npos;
-    detection_rows.push_back(csv ? readCsvDetections(path) : readTrackingLabels(path));
+    detection_rows.push_back(readDetectionRows(path));
   }
   if (!hasScans()) {
     // Without scans the sequence is as long as its labels and detections say.

@@ -1,9 +1,12 @@
-// dlslot-player: plays a KITTI (tracking or odometry layout) sequence over LCM.
+// dlslot-player: plays a KITTI (tracking or odometry layout) sequence, or a folder of your own
+// scans with a YAML sensor calibration (--input DIR --calib FILE, scan_folder.hpp), over LCM.
 // Publishes LIDAR_SCAN, DETECTIONS (every frame, empty when none; source "files"; none with
 // --no-detections, when dlslot-detector makes them) and GROUND_TRUTH (when the data set has labels
 // or poses), at a rate or in lockstep with a downstream channel.
 #include <cstdio>
 #include <deque>
+#include <functional>
+#include <optional>
 #include <iostream>
 
 #include "dlslot/convert.hpp"
@@ -15,6 +18,7 @@
 #include "dlslot/progress.hpp"
 #include "dlslot/scan_encoding.hpp"
 #include "playback.hpp"
+#include "scan_folder.hpp"
 
 using namespace dlslot;
 
@@ -34,7 +38,7 @@ struct PlayerConfig {
 
 int run(int argc, char** argv) {
   NodeOptions node_opts;
-  std::string root, sequence, lockstep;
+  std::string root, sequence, lockstep, input, calib_path;
   std::vector<std::string> detections;
   double speed = 1.0, delay_s = 0.5;
   int start = 0, end = -1, in_flight = 1;
@@ -42,6 +46,8 @@ int run(int argc, char** argv) {
   CommandLine cl("dlslot-player", "Plays a KITTI sequence over LCM (LIDAR_SCAN, DETECTIONS, GROUND_TRUTH).");
   cl.option("--kitti", &root, "KITTI root (holding training/ or sequences/)");
   cl.option("--sequence", &sequence, "sequence name, e.g. 0000 or 07");
+  cl.option("--input", &input, "instead of --kitti: a folder of .pcd or .bin scans with times.txt (docs/data-formats.md)");
+  cl.option("--calib", &calib_path, "with --input: the YAML sensor calibration");
   cl.repeated("--detections", &detections, "detection file or directory (tracking format or comma-separated)");
   cl.option("--speed", &speed, "rate mode: real time x this factor; 0 = as fast as possible (default 1)");
   cl.option("--lockstep", &lockstep, "publish frame t+1 only after CHANNEL carried frame t");
@@ -62,18 +68,35 @@ int run(int argc, char** argv) {
   PlayerConfig cfg;
   cfg.read(root_cfg.section("player"));
   if (node_opts.check_config) return 0;
-  if (root.empty()) throw std::invalid_argument("--kitti ROOT is required");
+  if (root.empty() == input.empty()) throw std::invalid_argument("give either --kitti ROOT or --input DIR");
+  if (!input.empty() && calib_path.empty()) throw std::invalid_argument("--input needs --calib FILE (the sensor's YAML)");
+  if (root.empty() && sequence.empty()) sequence = "input";
   if (sequence.empty()) throw std::invalid_argument("--sequence SSSS is required");
   if (in_flight < 1) throw std::invalid_argument("--in-flight: expected an integer >= 1, got " + std::to_string(in_flight));
   if (no_detections && !detections.empty())
     throw std::invalid_argument("--no-detections and --detections exclude each other");
 
-  kitti::SequenceReader reader(root, sequence, detections, cfg.min_detection_score, cfg.frame_period_s);
-  if (!reader.hasScans())
-    throw InputError(root, 0, "sequence " + sequence + " has no scans (expected training/velodyne/" + sequence +
-                                  "/): the player needs them; for tracking on detections alone use dlslot-tracker "
-                                  "--kitti or ./dlslot track-eval");
-  const player::FrameRange range = player::resolveRange({start, end}, reader.size());
+  // The frames to play, from either source.
+  std::function<Frame(int)> readFrame;
+  int num_frames = 0;
+  bool has_labels = false;
+  std::optional<kitti::SequenceReader> kitti_reader;
+  std::optional<player::FolderReader> folder_reader;
+  if (!root.empty()) {
+    kitti_reader.emplace(root, sequence, detections, cfg.min_detection_score, cfg.frame_period_s);
+    if (!kitti_reader->hasScans())
+      throw InputError(root, 0, "sequence " + sequence + " has no scans (expected training/velodyne/" + sequence +
+                                    "/): the player needs them; for tracking on detections alone use dlslot-tracker "
+                                    "--kitti or ./dlslot track-eval");
+    readFrame = [&](int i) { return kitti_reader->read(i); };
+    num_frames = kitti_reader->size();
+    has_labels = kitti_reader->hasLabels();
+  } else {
+    folder_reader.emplace(input, player::readSensorCalibration(calib_path), detections, cfg.min_detection_score);
+    readFrame = [&](int i) { return folder_reader->read(i); };
+    num_frames = folder_reader->size();
+  }
+  const player::FrameRange range = player::resolveRange({start, end}, num_frames);
 
   Node node("player", node_opts.lcm_url, channels);
   installSignalHandlers();
@@ -105,7 +128,7 @@ int run(int argc, char** argv) {
   std::deque<int> unacked;          // lockstep: frames published, not yet carried by the channel
   for (int i = range.start; i <= range.end && !signalReceived(); ++i) {
     const auto tic = Node::Clock::now();
-    Frame frame = reader.read(i);
+    Frame frame = readFrame(i);
     if (lockstep.empty()) {
       if (!pacer) pacer.emplace(frame.utime, speed);
       const auto due = t0 + std::chrono::duration_cast<Node::Clock::duration>(
@@ -126,7 +149,7 @@ int run(int argc, char** argv) {
       node.publish(channels.detections, det);
     }
 
-    if (frame.gt_pose || reader.hasLabels()) {
+    if (frame.gt_pose || has_labels) {
       ground_truth_t gt;
       gt.utime = frame.utime;
       gt.frame = frame.index;

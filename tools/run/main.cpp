@@ -19,6 +19,11 @@
 #include <sstream>
 #include <thread>
 #include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <yaml-cpp/yaml.h>
+
+#include "dlslot/input_error.hpp"
 
 #include "dlslot/frame_accounting.hpp"
 #include "dlslot/kitti.hpp"
@@ -27,6 +32,7 @@
 #include "dlslot/progress.hpp"
 #include "dlslot/receive_buffer.hpp"
 #include "dlslot/slot_state_t.hpp"
+#include "scan_folder.hpp"
 #include "supervisor.hpp"
 
 using namespace dlslot;
@@ -70,6 +76,46 @@ std::string detectionSource(const std::string& requested, bool have_files, bool 
   std::cerr << "detections: no --detections given, so dlslot-detector (geometric) detects from the scans "
                "(--detector files to run without detections)\n";
   return "geometric";
+}
+
+// The run's config for a folder of the user's scans: the odometry's beam model (and the
+// detector's top beam) from the sensor calibration, or estimated from the first scan. Written to
+// OUT/config.yaml, which every process then reads.
+std::string sensorConfig(const std::string& config, const player::SensorCalibration& calib,
+                         const player::ScanFolder& folder, const std::string& out) {
+  YAML::Node cfg = YAML::LoadFile(config);
+  std::string model = calib.beam_model;
+  int beams = calib.beams;
+  double top = calib.top_elevation_deg, bottom = calib.bottom_elevation_deg;
+  if (model == "estimate") {
+    const player::BeamLayout b = player::estimateBeams(player::readScanFile(folder.files.front()));
+    beams = b.beams, top = b.top_elevation_deg, bottom = b.bottom_elevation_deg;
+    std::cerr << "sensor: " << b.beams << " beams estimated from " << folder.files.front() << ", " << bottom << " .. "
+              << top << " deg" << (b.uniform ? ", evenly spaced" : ", unevenly spaced") << "\n";
+    if (b.uniform)
+      model = "uniform";
+    else if (b.beams >= 60 && b.beams <= 64 && std::abs(top - 2.0) < 0.5 && std::abs(bottom + 24.3) < 1.0)
+      model = "hdl64";  // the HDL-64E's two blocks of beam spacing
+    else
+      throw InputError(calib.path, 0, "beams: estimated " + std::to_string(b.beams) +
+                                          " unevenly spaced beams the odometry has no model for; give "
+                                          "beams: {model: uniform, count, elevation_deg} or hdl64");
+  }
+  YAML::Node features = cfg["odometry"]["features"];
+  features["beam_model"] = model;
+  if (model == "uniform") {
+    features["num_beams"] = beams;
+    features["min_vertical_deg"] = bottom;
+    features["max_vertical_deg"] = top;
+    cfg["detector"]["classes"]["top_beam_deg"] = top;
+  }
+  const std::string path = out + "/config.yaml";
+  std::ofstream f(path);
+  f << "# " << config << " with the sensor of " << calib.path << "\n" << cfg << "\n";
+  if (!f) throw std::runtime_error(path + ": cannot write");
+  std::cerr << "sensor: odometry beam model " << model
+            << (model == "uniform" ? " (" + std::to_string(beams) + " beams)" : std::string()) << "; config " << path << "\n";
+  return path;
 }
 
 std::string binDir() { return fs::read_symlink("/proc/self/exe").parent_path().string(); }
@@ -121,6 +167,7 @@ int runPipeline(int argc, char** argv) {
   argc = static_cast<int>(arg_ptrs.size());
   argv = arg_ptrs.data();
   int foxglove_port = -1;
+  std::string input, sensor_calib;
   std::string root, sequence = "0000", scenario, mode = "slot", config = "config/dlslot.yaml", out, lcm_url, detector;
   std::vector<std::string> detections;
   int frames = -1, seed = 1, in_flight = 2;
@@ -134,6 +181,8 @@ int runPipeline(int argc, char** argv) {
             "geometric (dlslot-detector on the scans) | files (--detections, a scenario's simulated ones); "
             "default: files when there are any, else geometric");
   cl.option("--scenario", &scenario, "simulate this scenario (name or YAML) first, then run on it");
+  cl.option("--input", &input, "a folder of your own .pcd or .bin scans with times.txt (docs/data-formats.md)");
+  cl.option("--calib", &sensor_calib, "with --input: the sensor's YAML calibration");
   cl.option("--frames", &frames, "frames to simulate (with --scenario) or to play (default: all)");
   cl.option("--seed", &seed, "simulator seed (default 1)");
   cl.option("--mode", &mode, "slot | aloam | aloam-filtered | two-stage (default slot)");
@@ -159,7 +208,9 @@ int runPipeline(int argc, char** argv) {
   if (out.empty()) throw std::invalid_argument("--out DIR is required");
   if (in_flight < 1) throw std::invalid_argument("--in-flight: expected an integer >= 1");
   config = fs::absolute(findConfigFile(config)).string();  // the children get the same file from any directory
-  if (root.empty() == scenario.empty()) throw std::invalid_argument("give either --kitti ROOT or --scenario NAME");
+  if (int(!root.empty()) + int(!scenario.empty()) + int(!input.empty()) != 1)
+    throw std::invalid_argument("give one of --kitti ROOT, --scenario NAME or --input DIR --calib FILE");
+  if (!input.empty() && sensor_calib.empty()) throw std::invalid_argument("--input needs --calib FILE");
   const ModeSettings ms = settingsFor(mode);
   const std::string source = detectionSource(detector, !detections.empty() || !scenario.empty(), !scenario.empty());
   const bool geometric = source == "geometric";
@@ -173,7 +224,14 @@ int runPipeline(int argc, char** argv) {
   {
     ConfigSection cfg = loadConfig(config);  // throws a clear ConfigError
     (void)cfg;
-    fs::copy_file(config, out + "/config.yaml", fs::copy_options::overwrite_existing);
+    if (!input.empty()) {
+      input = fs::absolute(input).string();
+      sensor_calib = fs::absolute(sensor_calib).string();
+      const player::SensorCalibration calib = player::readSensorCalibration(sensor_calib);
+      config = sensorConfig(config, calib, player::openScanFolder(input, calib), out);
+    } else {
+      fs::copy_file(config, out + "/config.yaml", fs::copy_options::overwrite_existing);
+    }
     for (const std::string p : {"player", "detector", "odometry", "tracker", "backend", "renderer", "mapper", "foxglove"}) {
       if ((no_render && p == "renderer") || (!geometric && p == "detector") || (!foxglove && p == "foxglove") ||
           (no_map && p == "mapper"))
@@ -195,7 +253,8 @@ int runPipeline(int argc, char** argv) {
       throw Failure("dlslot-sim failed:\n" + sup.tail("sim"));
     detections = geometric ? std::vector<std::string>{} : std::vector<std::string>{root + "/detections/sim"};
   }
-  const int num_frames = kitti::locateSequence(root, sequence).num_frames;
+  const int num_frames = input.empty() ? kitti::locateSequence(root, sequence).num_frames
+                                       : static_cast<int>(player::openScanFolder(input, player::readSensorCalibration(sensor_calib)).files.size());
   const int last_frame = (frames > 0 && scenario.empty()) ? std::min(frames, num_frames) - 1 : num_frames - 1;
 
   // 3. Start the pipeline, consumers first.
@@ -310,8 +369,11 @@ int runPipeline(int argc, char** argv) {
                     sup.logPath(p) + "):\n" + sup.tail(p));
     }
   };
-  std::vector<std::string> play = {"--kitti", root, "--sequence", sequence, "--quiet", "--delay", "0.2",
-                                   "--end", std::to_string(last_frame)};
+  std::vector<std::string> play = {"--quiet", "--delay", "0.2", "--end", std::to_string(last_frame)};
+  if (input.empty())
+    play.insert(play.end(), {"--kitti", root, "--sequence", sequence});
+  else
+    play.insert(play.end(), {"--input", input, "--calib", sensor_calib});
   for (const auto& d : detections) play.insert(play.end(), {"--detections", d});
   if (geometric) play.push_back("--no-detections");
   if (speed > 0)
@@ -423,8 +485,14 @@ int runPipeline(int argc, char** argv) {
   // 6. Evaluate and export.
   if (!no_eval) {
     std::vector<std::string> eval = {bin + "/dlslot-eval", "--config", config, "--log", out + "/run.lcmlog",
-                                     "--kitti", root, "--sequence", sequence, "--out", out, "--export", out};
-    if (!no_map) eval.insert(eval.end(), {"--map", out});
+                                     "--out", out, "--export", out};
+    if (input.empty()) {
+      eval.insert(eval.end(), {"--kitti", root, "--sequence", sequence});
+      if (!no_map) eval.insert(eval.end(), {"--map", out});
+    } else {  // ground truth from the run's log (the player's poses.txt), detections' calib for KITTI exports
+      const std::string cam = player::readSensorCalibration(sensor_calib).camera_calib;
+      if (!cam.empty()) eval.insert(eval.end(), {"--calib", cam});
+    }
     if (runToEnd(sup, "eval", eval, logs + "/eval.log") != 0) throw Failure("dlslot-eval failed:\n" + sup.tail("eval", 30));
     std::cout << run::readText(logs + "/eval.log");
   }

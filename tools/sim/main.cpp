@@ -1,6 +1,7 @@
 // dlslot-sim: writes a synthetic KITTI tracking sequence with exact ground truth.
 //   dlslot-sim --scenario NAME|FILE.yaml --out DIR [--frames N] [--seed S] [--sequence 0000] [--threads T]
 #include <algorithm>
+#include <map>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -11,7 +12,8 @@
 
 int main(int argc, char** argv) {
   std::string scenario_arg, out, sequence = "0000";
-  int frames = -1, seed = -1;  // -1: the scenario's
+  int frames = -1, seed = -1, beams = -1;  // -1: the scenario's
+  bool pcd = false;
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   dlslot::CommandLine cl("dlslot-sim",
                          "Writes a synthetic KITTI tracking sequence (scans, labels, calib, oxts, poses, detections) "
@@ -22,6 +24,10 @@ int main(int argc, char** argv) {
   cl.option("--frames", &frames, "number of scans (default: the scenario's)");
   cl.option("--seed", &seed, "random seed (default: the scenario's); same seed, same bytes");
   cl.option("--sequence", &sequence, "sequence name, four digits (default 0000)");
+  cl.option("--beams", &beams,
+            "the lidar's beam count: 64 (HDL-64E, the default), 32 (HDL-32E: +10.67..-30.67 deg), 128 (+15..-25 deg), "
+            "16 (VLP-16: +15..-15 deg); other layouts: sensor.beams/top_elevation_deg/bottom_elevation_deg in a scenario");
+  cl.flag("--pcd", &pcd, "also write OUT/pcd/: the scans as .pcd with times.txt, poses.txt and calib.yaml (your-own-data input)");
   cl.option("--threads", &threads, "ray-casting threads (default: the number of cores); results do not depend on it");
   try {
     if (!cl.parse(argc, argv)) return 0;
@@ -38,10 +44,23 @@ int main(int argc, char** argv) {
   }
   try {
     using namespace dlslot::sim;
-    const Scenario sc = loadScenario(resolveScenario(scenario_arg, DLSLOT_SOURCE_DIR));
+    Scenario sc = loadScenario(resolveScenario(scenario_arg, DLSLOT_SOURCE_DIR));
+    if (beams != -1) {
+      const std::map<int, std::pair<double, double>> layouts = {
+          {16, {15.0, -15.0}}, {32, {10.67, -30.67}}, {64, {2.0, -24.33}}, {128, {15.0, -25.0}}};
+      const auto it = layouts.find(beams);
+      if (it == layouts.end()) throw std::invalid_argument("--beams: expected 16, 32, 64 or 128, got " + std::to_string(beams));
+      sc.sensor.beams = beams;
+      sc.sensor.top_elevation_deg = it->second.first;
+      sc.sensor.bottom_elevation_deg = it->second.second;
+      // The written scenario.yaml says so too.
+      sc.source["sensor"]["beams"] = beams;
+      sc.source["sensor"]["top_elevation_deg"] = it->second.first;
+      sc.source["sensor"]["bottom_elevation_deg"] = it->second.second;
+    }
     const SequenceStats st =
         writeSequence(sc, frames > 0 ? frames : sc.frames, seed >= 0 ? static_cast<uint64_t>(seed) : sc.seed, out,
-                      sequence, {threads, true});
+                      sequence, {threads, true, pcd});
     std::printf(
         "dlslot-sim: %s -> %s sequence %s: %d frames in %.1f s (%.0f ms/frame), %.0f points/scan, "
         "%d objects (%d removed as overlapping), %d tracks, ego path %.0f m\n",

@@ -187,6 +187,12 @@ PathSpec readPath(Section& s, const std::vector<RoadSpec>& roads) {
 }
 
 void readSensor(Section s, SensorSpec& o) {
+  s.optional("beams", o.beams);
+  if (o.beams < 2 || o.beams > 255) s.fail("beams", "expected 2..255 beams, got " + std::to_string(o.beams));
+  s.optional("top_elevation_deg", o.top_elevation_deg);
+  s.optional("bottom_elevation_deg", o.bottom_elevation_deg);
+  if (!(o.top_elevation_deg > o.bottom_elevation_deg && o.top_elevation_deg < 90 && o.bottom_elevation_deg > -90))
+    s.fail("top_elevation_deg", "expected -90 < bottom_elevation_deg < top_elevation_deg < 90");
   s.optional("azimuth_steps", o.azimuth_steps);
   if (o.azimuth_steps < 100) s.fail("azimuth_steps", "expected at least 100");
   s.optional("max_range_m", o.max_range_m);

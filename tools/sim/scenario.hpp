@@ -101,7 +101,11 @@ struct TrafficSpec {
   double stop_probability = 0.0;  // chance an agent stops for a while somewhere
 };
 
-struct SensorSpec {  // HDL-64E-like; the imperfections of a real one, see sensor_model.hpp
+struct SensorSpec {  // HDL-64E-like by default; the imperfections of a real one, see sensor_model.hpp
+  // Beam layout: 64 beams are the HDL-64E's own (non-uniform) elevations; any other count is spread
+  // evenly from top_elevation_deg (beam 0) to bottom_elevation_deg, as on 16/32/128-beam sensors.
+  int beams = 64;
+  double top_elevation_deg = 2.0, bottom_elevation_deg = -24.33;
   int azimuth_steps = 2000;
   double max_range_m = 120.0, min_range_m = 2.5;
   double height_m = 1.73;

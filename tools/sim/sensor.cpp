@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 #include "rng.hpp"
@@ -68,6 +70,12 @@ double beamElevationDeg(int beam) {
   return beam < 32 ? 2.0 - beam / 3.0 : -8.83 - 0.5 * (beam - 32);
 }
 
+double beamElevationDeg(const SensorSpec& sensor, int beam) {
+  if (sensor.beams == kBeams) return beamElevationDeg(beam);
+  return sensor.top_elevation_deg -
+         beam * (sensor.top_elevation_deg - sensor.bottom_elevation_deg) / (sensor.beams - 1);
+}
+
 int aloamBeam(double angle) {
   return angle >= -8.83 ? static_cast<int>((2 - angle) * 3.0 + 0.5)
                         : 32 + static_cast<int>((-8.83 - angle) * 2.0 + 0.5);
@@ -105,17 +113,22 @@ Scan scan(const SensorSpec& sensor, const ScanInput& in, int threads) {
   };
   const Pose T_ref_map = in.ego.T_ref.inverse();
 
-  std::vector<BeamPoints> out(kBeams);
-  threads = std::clamp(threads, 1, kBeams);
+  const int beams = sensor.beams;
+  if (!in.beam_errors.empty() && static_cast<int>(in.beam_errors.size()) != beams)
+    throw std::invalid_argument("sim::scan: " + std::to_string(in.beam_errors.size()) + " beam residuals for " +
+                                std::to_string(beams) + " beams");
+  std::vector<BeamPoints> out(beams);
+  threads = std::clamp(threads, 1, beams);
   std::vector<std::vector<ObjectView>> views(threads, std::vector<ObjectView>(in.object_boxes.size()));
 
   auto work = [&](int thread) {
     SolidGrid::Scratch scratch = world.grid->scratch();
     std::vector<std::pair<int, double>> entered;  // objects whose box this ray enters, and where
-    for (int b = thread; b < kBeams; b += threads) {
-      const BeamError& err = in.beam_errors[b];
+    for (int b = thread; b < beams; b += threads) {
+      static const BeamError kExact{};  // no residuals given: the rays leave at the nominal angles
+      const BeamError& err = in.beam_errors.empty() ? kExact : in.beam_errors[b];
       // The stored point has the beam's nominal elevation; the ray leaves at the true one.
-      const double el = beamElevationDeg(b) * M_PI / 180.0, el_true = el + err.elevation_rad;
+      const double el = beamElevationDeg(sensor, b) * M_PI / 180.0, el_true = el + err.elevation_rad;
       const double ce = std::cos(el), se = std::sin(el);
       const double ce_true = std::cos(el_true), se_true = std::sin(el_true);
       const double ca_err = std::cos(err.azimuth_rad), sa_err = std::sin(err.azimuth_rad);
@@ -203,7 +216,7 @@ Scan scan(const SensorSpec& sensor, const ScanInput& in, int threads) {
   for (const BeamPoints& bp : out) total += bp.object.size();
   result.points.resize(4, static_cast<Eigen::Index>(total));
   size_t at = 0;
-  for (int b = 0; b < kBeams; ++b) {
+  for (int b = 0; b < beams; ++b) {
     const BeamPoints& bp = out[b];
     std::copy(bp.xyzi.begin(), bp.xyzi.end(), result.points.data() + 4 * at);
     result.beam.insert(result.beam.end(), bp.object.size(), static_cast<uint8_t>(b));

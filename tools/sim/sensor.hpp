@@ -17,10 +17,13 @@
 
 namespace dlslot::sim {
 
-constexpr int kBeams = 64;
-// Elevation of each beam in degrees, beam 0 the highest: the upper block +2.0 .. -8.33 in 1/3 deg
-// steps, the lower block -8.83 .. -24.33 in 1/2 deg steps.
+constexpr int kBeams = 64;  // the HDL-64E's
+// Elevation of each HDL-64E beam in degrees, beam 0 the highest: the upper block +2.0 .. -8.33 in
+// 1/3 deg steps, the lower block -8.83 .. -24.33 in 1/2 deg steps.
 double beamElevationDeg(int beam);
+// Elevation of a beam of the sensor's layout (SensorSpec::beams): the HDL-64E's for 64 beams,
+// else evenly spaced from the top to the bottom elevation.
+double beamElevationDeg(const SensorSpec& sensor, int beam);
 // The beam A-LOAM's scanRegistration assigns to a point of this elevation for a 64-beam lidar.
 int aloamBeam(double elevation_deg);
 
@@ -50,7 +53,7 @@ struct ScanInput {
   std::vector<Solid> object_solids;     // map frame at the reference time, owner = object index
   std::vector<Box> object_boxes;        // map frame, per object (for visibility counts)
   std::vector<Eigen::Vector3d> object_velocity;  // map frame, per object (empty: all standing)
-  std::array<BeamError, kBeams> beam_errors{};   // the sensor's calibration residuals
+  std::vector<BeamError> beam_errors;            // the sensor's calibration residuals, one per beam (none: exact)
   uint64_t key = 0;                              // random stream of this frame
 };
 

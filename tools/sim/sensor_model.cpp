@@ -24,9 +24,9 @@ SensorSpec idealSensor(SensorSpec s) {
   return s;
 }
 
-std::array<BeamError, 64> beamErrors(const SensorSpec& sensor, uint64_t key) {
-  std::array<BeamError, 64> e{};
-  for (int b = 0; b < 64; ++b) {
+std::vector<BeamError> beamErrors(const SensorSpec& sensor, uint64_t key) {
+  std::vector<BeamError> e(sensor.beams);
+  for (int b = 0; b < sensor.beams; ++b) {
     Rng rng(streamKey({key, static_cast<uint64_t>(b)}));
     // Drawn whether used or not, so switching one residual off leaves the others as they were.
     const double el = rng.normal(), az = rng.normal(), range = rng.normal();

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <vector>
 #include <cstdint>
 
 #include "dlslot/types.hpp"
@@ -24,7 +25,7 @@ struct BeamError {
 // Per-beam residuals drawn N(0, sigma) from `key` (the sensor of one scenario seed), plus the
 // common vertical-angle error (KITTI's scans: the rays point vertical_angle_error_deg higher than
 // the stored points say). All zero when the sensor's calibration residuals are off.
-std::array<BeamError, 64> beamErrors(const SensorSpec& sensor, uint64_t key);
+std::vector<BeamError> beamErrors(const SensorSpec& sensor, uint64_t key);  // one per beam
 
 // Phase of the first firing of a revolution, in columns [0, 1): a lidar's firing clock runs free of
 // its rotation, so successive scans sample different azimuths. 0 when azimuth_phase is off.

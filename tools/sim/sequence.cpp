@@ -1,5 +1,10 @@
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
+
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 #include "calib.hpp"
 #include "dlslot/kitti.hpp"
@@ -11,6 +16,41 @@
 namespace fs = std::filesystem;
 
 namespace dlslot::sim {
+
+namespace {
+
+// times.txt, the vehicle's poses and the sensor's YAML calibration beside the .pcd scans. The
+// vehicle frame is the ground point under the lidar (the lidar sits sensor.height_m above it).
+void writePcdFolderFiles(const fs::path& dir, const Scenario& scenario, const std::vector<Pose>& lidar_poses,
+                         const std::string& sequence) {
+  const SensorSpec& s = scenario.sensor;
+  {
+    std::ofstream t(dir / "times.txt");
+    for (size_t k = 0; k < lidar_poses.size(); ++k) {
+      char line[32];
+      std::snprintf(line, sizeof line, "%.6f\n", k * scenario.frame_period_s);
+      t << line;
+    }
+  }
+  Pose T_vehicle_lidar = Pose::Identity();
+  T_vehicle_lidar.translation() << 0, 0, s.height_m;
+  std::vector<Pose> vehicle;
+  for (const Pose& T : lidar_poses) vehicle.push_back(T * T_vehicle_lidar.inverse());
+  kitti::writePoses((dir / "poses.txt").string(), vehicle);
+  std::ofstream c(dir / "calib.yaml");
+  c << "# The simulated sensor (dlslot-sim, scenario " << scenario.name << ", seed " << scenario.seed << ").\n"
+    << "sensor_to_vehicle:\n  translation: [0, 0, " << s.height_m << "]\n  rotation_rpy_deg: [0, 0, 0]\n"
+    << "beams:\n";
+  if (s.beams == kBeams)
+    c << "  model: hdl64\n";
+  else
+    c << "  model: uniform\n  count: " << s.beams << "\n  elevation_deg: [" << s.top_elevation_deg << ", "
+      << s.bottom_elevation_deg << "]\n";
+  c << "range_m: [" << s.min_range_m << ", " << s.max_range_m << "]\n"
+    << "camera_calib: ../training/calib/" << sequence << ".txt  # the detection files are in camera coordinates\n";
+}
+
+}  // namespace
 
 SequenceStats writeSequence(const Scenario& scenario_in, int frames, uint64_t seed, const std::string& out_dir,
                             const std::string& sequence, const WriteOptions& options) {
@@ -35,6 +75,11 @@ SequenceStats writeSequence(const Scenario& scenario_in, int frames, uint64_t se
   stats.removed = sim.motion().removed;
   stats.ego_path_end_frame = sim.motion().ego_path_end_frame;
   std::vector<kitti::LabelRow> labels, detections;
+  const fs::path pcd = root / "pcd";
+  if (options.pcd_folder) {
+    fs::remove_all(pcd);
+    fs::create_directories(pcd);
+  }
   ProgressLine progress("dlslot-sim " + scenario.name, frames);
   double points = 0;
   for (int k = 0; k < frames; ++k) {
@@ -42,6 +87,17 @@ SequenceStats writeSequence(const Scenario& scenario_in, int frames, uint64_t se
     char name[32];
     std::snprintf(name, sizeof name, "%06d.bin", k);
     kitti::writeVelodyne((velodyne / name).string(), fd.scan.points);
+    if (options.pcd_folder) {
+      pcl::PointCloud<pcl::PointXYZI> cloud;
+      cloud.resize(fd.scan.points.cols());
+      for (Eigen::Index i = 0; i < fd.scan.points.cols(); ++i) {
+        auto& p = cloud[i];
+        p.x = fd.scan.points(0, i), p.y = fd.scan.points(1, i), p.z = fd.scan.points(2, i), p.intensity = fd.scan.points(3, i);
+      }
+      std::snprintf(name, sizeof name, "%06d.pcd", k);
+      if (pcl::io::savePCDFileBinary((pcd / name).string(), cloud) != 0)
+        throw std::runtime_error((pcd / name).string() + ": cannot write");
+    }
     points += fd.scan.points.cols();
     labels.insert(labels.end(), fd.labels.begin(), fd.labels.end());
     detections.insert(detections.end(), fd.detections.begin(), fd.detections.end());
@@ -56,6 +112,7 @@ SequenceStats writeSequence(const Scenario& scenario_in, int frames, uint64_t se
   kitti::writeOxts((training / "oxts" / file).string(),
                    simulatedOxts(poses, *sim.calib().T_velo_imu, scenario.frame_period_s));
   writeScenario((root / "scenario.yaml").string(), scenario);
+  if (options.pcd_folder) writePcdFolderFiles(pcd, scenario, poses, sequence);
 
   stats.mean_points = points / frames;
   for (const kitti::LabelRow& r : labels) stats.labelled_tracks = std::max(stats.labelled_tracks, r.track_id + 1);

@@ -32,6 +32,9 @@ struct SequenceStats {
 struct WriteOptions {
   int threads = 1;
   bool progress = false;  // a progress line on stderr
+  // Also write the sequence as a folder of your-own-data input (OUT/pcd/: NNNNNN.pcd, times.txt,
+  // poses.txt of the vehicle, calib.yaml; procs/player/scan_folder.hpp).
+  bool pcd_folder = false;
 };
 
 // Writes `frames` frames of the scenario from `seed` (both override the scenario's own).

@@ -41,7 +41,7 @@ class Simulation {
   std::vector<int> track_id_;  // per agent, -1 until first labelled
   int next_track_id_ = 0;
   int next_frame_ = 0;
-  std::array<BeamError, kBeams> beam_errors_;  // the sensor's calibration residuals (one per seed)
+  std::vector<BeamError> beam_errors_;  // the sensor's calibration residuals (one per seed)
 };
 
 }  // namespace dlslot::sim

@@ -88,6 +88,9 @@ std::optional<LabelRow> resultRow(LabelRow row, const Calib& calib, const ImageS
 // The comma-separated detection format: frame,type,x1,y1,x2,y2,score,h,w,l,x,y,z,rot_y,alpha
 // with type 1 Pedestrian, 2 Car, 3 Cyclist.
 std::vector<LabelRow> readCsvDetections(const std::string& path);
+// A detection file of either format (tracking format with a score column, or comma-separated),
+// told apart by its first line.
+std::vector<LabelRow> readDetectionRows(const std::string& path);
 
 // Groups rows by frame, converted to the lidar frame. DontCare rows go to `dontcare` when given
 // (else dropped); rows with score < min_score are dropped (rows without score are kept).

@@ -1,5 +1,8 @@
 #include "dlslot/config.hpp"
 
+#include <iterator>
+
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -56,6 +59,14 @@ void ConfigSection::get(const std::string& key, T& out) {
       if (!n.IsSequence()) throw YAML::Exception(n.Mark(), "");
     }
     out = n.as<T>();
+    // .nan and .inf are numbers to YAML but never a setting: refused like a misspelt key.
+    bool finite = true;
+    if constexpr (std::is_same_v<T, double>) finite = std::isfinite(out);
+    if constexpr (std::is_same_v<T, std::vector<double>>)
+      for (double v : out) finite = finite && std::isfinite(v);
+    if (!finite)
+      throw ConfigError(where(key) + " (line " + std::to_string(n.Mark().line + 1) +
+                        "): expected a finite number, got " + (n.IsScalar() ? "'" + n.Scalar() + "'" : "a list with one that is not"));
   } catch (const YAML::Exception&) {
     std::string got = n.IsScalar() ? "'" + n.Scalar() + "'" : n.IsSequence() ? "a list" : "a map";
     throw ConfigError(where(key) + " (line " + std::to_string(n.Mark().line + 1) + "): expected " +
@@ -140,6 +151,19 @@ void Channels::read(ConfigSection s) {
   s.get("associations", associations);
   s.get("slot_state", slot_state);
   s.get("status", status);
+  if (s.has("run_event")) s.get("run_event", run_event);
+  const std::pair<const char*, const std::string*> all[] = {
+      {"scan", &scan},           {"detections", &detections}, {"ground_truth", &ground_truth},
+      {"odometry", &odometry},   {"associations", &associations}, {"slot_state", &slot_state},
+      {"status", &status},       {"run_event", &run_event}};
+  for (size_t i = 0; i < std::size(all); ++i) {
+    if (all[i].second->empty())
+      throw ConfigError(s.file() + ": " + s.path() + "." + all[i].first + ": expected a channel name, got ''");
+    for (size_t j = 0; j < i; ++j)
+      if (*all[i].second == *all[j].second)
+        throw ConfigError(s.file() + ": " + s.path() + "." + all[i].first + ": channel '" + *all[i].second +
+                          "' is already " + s.path() + "." + all[j].first + "; every channel needs a name of its own");
+  }
   s.finish();
 }
 

@@ -1,4 +1,4 @@
-// Detector speed (issue 18: <= 15 ms mean per 123k-point scan, one thread) on the real KITTI scans
+// Detector speed (goal: <= 15 ms mean per 123k-point scan, one thread) on the real KITTI scans
 // of ../shared/data/kitti-tracking-0000-head when present (else on ray-cast street scenes), with
 // the split per stage. BM_Cluster* compares the two ways to cluster the same obstacle points:
 // the range-image neighbourhood the detector uses, and PCL's EuclideanClusterExtraction (k-d tree

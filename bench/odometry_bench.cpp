@@ -1,4 +1,4 @@
-// Odometry speed (issue 16: <= 20 ms a frame mean, p95 <= 30 ms, single-threaded, 120k-point
+// Odometry speed (goal: <= 20 ms a frame mean, p95 <= 30 ms, single-threaded, 120k-point
 // HDL-64 frames): per-frame CPU time of this thread (frame_cpu_*: what the odometry costs,
 // whatever else runs on the machine) and wall time (frame_wall_*), mean and p95, and the CPU split
 // inside (the _* counters: OdometryResult::detail), on the real KITTI scans of

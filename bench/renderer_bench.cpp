@@ -1,4 +1,4 @@
-// Renderer speed (issue 7: <= 20 ms per 1000x1000 frame with 120k points, to keep up at 10 Hz).
+// Renderer speed (goal: <= 20 ms per 1000x1000 frame with 120k points, to keep up at 10 Hz).
 // Prints mean and p95 per frame for drawing alone, for PNG encoding alone and for both, on a
 // synthetic 120k-point HDL-64E-like scan and, when the KITTI slice is present, on a real scan.
 #include <benchmark/benchmark.h>

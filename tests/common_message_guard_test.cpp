@@ -1,5 +1,5 @@
 // The message guard (common/include/dlslot/message_guard.hpp): its layout walk agrees with
-// lcm-gen's encoder byte for byte, every malformed variant of issue 17 is refused with the right
+// lcm-gen's encoder byte for byte, every malformed variant is refused with the right
 // reason (never thrown, never allocated for), and FrameOrder's duplicate/old/jump rules (no resync).
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Issue 18: geometric detections start tracks. The score table's known answers and errors, the
+// Geometric detections start tracks. The score table's known answers and errors, the
 // shipped tables against the tracker's thresholds, and the two class rules measured on the
 // highway's misses (a van's back is no cyclist; a far car's low back is still a car).
 #include <gtest/gtest.h>
@@ -130,7 +130,7 @@ TEST(ScoreCalibrationTest, PlainlySeenObjectsPassTheTrackersThresholds) {
   }
   EXPECT_EQ(cars, 1);
   EXPECT_EQ(pedestrians, 1);
-  // With the raw scores (identity table) the car would start no track: what issue 18 was about.
+  // With the raw scores (identity table) the car would start no track: why the table exists.
   DetectorConfig raw = det_cfg;
   raw.scores.vehicle = {{-10.0, 10.0}, {-10.0, 10.0}};
   for (const Box& b : detectObjects(scene.scan(), raw).boxes) {

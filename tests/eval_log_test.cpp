@@ -438,8 +438,8 @@ TEST_F(EvalLog, TruncatedCorruptEmptyAndMissingLogsAreClearErrors) {
               std::string::npos) << r.err;
   }
 
-  // A message that does not decode as the channel's type: skipped, counted and named (issue 17:
-  // one bad message no longer makes a recorded run unreadable); nothing else here, so no truth.
+  // A message that does not decode as the channel's type: skipped, counted and named
+  // (one bad message must not make a recorded run unreadable); nothing else here, so no truth.
   {
     lcm::LogFile log(path("wrongtype.lcmlog"), "w");
     ground_truth_t gt{};

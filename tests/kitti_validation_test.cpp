@@ -1,4 +1,4 @@
-// Issue 17, item 3: every field of every file format is checked (finite, size > 0, in range),
+// Every field of every file format is checked (finite, size > 0, in range),
 // directories are refused as such, and each error names file, line, field and what was expected.
 #include <gtest/gtest.h>
 

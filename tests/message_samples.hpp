@@ -1,5 +1,5 @@
 // Valid messages of every type, their encodings and the malformed variants a hostile sender could
-// publish (issue 17): shared by the guard's unit test, the malformed-message process test and the
+// publish: shared by the guard's unit test, the malformed-message process test and the
 // fuzz corpus writer.
 #pragma once
 

@@ -1,4 +1,4 @@
-// Issue 17, items 1 and 9: every malformed case published to every node of a running pipeline
+// Every malformed case published to every node of a running pipeline
 // (dlslot-run on a short simulated sequence, lockstep, renderer on, inside a private network
 // namespace). Each node survives, counts every case it refused in PROCESS_STATUS by channel and
 // reason, and the pipeline still finishes the sequence; then the offline readers of the recorded

@@ -1,4 +1,4 @@
-// Issue 17, item 8: the pipeline across two hosts. Two network namespaces joined by a veth pair
+// The pipeline across two hosts. Two network namespaces joined by a veth pair
 // stand for two machines on one link, with multicast routed over it: the player and the odometry
 // run on "the vehicle" (this test's namespace), the tracker, backend, renderer and a logger on
 // "the other machine", every process with the README's multi-host LCM URL (section "Across

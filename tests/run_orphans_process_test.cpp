@@ -1,4 +1,4 @@
-// Issue 17, item 4: no process of a run outlives the launcher. dlslot-run is killed with SIGKILL
+// No process of a run outlives the launcher. dlslot-run is killed with SIGKILL
 // (no chance to stop anything) while its pipeline plays; every child it had must be gone soon
 // after (the kernel's parent-death signal, tools/run/supervisor.cpp).
 #include <gtest/gtest.h>

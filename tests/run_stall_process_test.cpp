@@ -1,4 +1,4 @@
-// Issue 17, item 2: a stall is seen per process, not only for the whole pipeline. The odometry is
+// A stall is seen per process, not only for the whole pipeline. The odometry is
 // stopped with SIGSTOP mid-run (alive, silent, holding its frames); the launcher must name it as
 // stalled once its heartbeat (PROCESS_STATUS, 1 Hz) has been missing for --heartbeat-timeout
 // seconds, exit 3, and leave nothing running.

@@ -15,8 +15,8 @@ using namespace dlslot;
 
 namespace {
 
-// The ideal lidar of issue 3: these tests check the ray caster's geometry; the imperfections of
-// issue 15 are checked in sim_sensor_model_test.cpp.
+// The ideal lidar: these tests check the ray caster's geometry; the imperfections
+// are checked in sim_sensor_model_test.cpp.
 sim::Scenario scenario(const std::string& name, int frames) {
   sim::Scenario sc = sim::test::shippedScenario(name, frames);
   sc.sensor = sim::idealSensor(sc.sensor);

@@ -1,4 +1,4 @@
-// The real lidar's imperfections (issue 15), each checked against its own definition in
+// The real lidar's imperfections, each checked against its own definition in
 // sensor_model.hpp: the formulas at known points, their random draws' statistics, and whole
 // scans: every point lies on the true ray of its beam, fired at its time of the sweep from where
 // the lidar was then, at the surface it names, off by the beam's range bias and noise of the

@@ -1,4 +1,4 @@
-// dlslot-detector: geometric object detection on raw LiDAR scans (issue 18), no neural network.
+// dlslot-detector: geometric object detection on raw LiDAR scans, no neural network.
 // Subscribes LIDAR_SCAN, publishes DETECTIONS (source "geometric") and PROCESS_STATUS: what the
 // player publishes from detection files, made from the scan itself, so DL-SLOT runs on any log.
 // With --kitti: the same detector offline over a sequence's files, with --eval recall and

@@ -40,7 +40,7 @@ int runOffline(const OfflineOptions& opts, const OdometryConfig& cfg) {
   std::map<Status, int> statuses;
   long removed = 0, points = 0;
   int scan_to_scan_runs = 0;  // scans that needed scan-to-scan (every_scan false: few)
-  // Per-scan statistics of registered scans, to compare simulated scans with real ones (issue 15).
+  // Per-scan statistics of registered scans, to compare simulated scans with real ones.
   TimingStats edges, planes, residuals, correspondences;
   ProgressLine progress("odometry " + opts.sequence + " (" + modeName(cfg.remove_detected_objects) + ")",
                         reader.size());

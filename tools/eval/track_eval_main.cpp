@@ -4,7 +4,7 @@
 // tracking.<class>.<k> (all sequences pooled, as AB3DMOT computes sAMOTA) and
 // sequences.<SSSS>.<class>.<k>.
 //
-// Two runs, because the two kinds of metric ask for two outputs (issue 14):
+// Two runs, because the two kinds of metric ask for two outputs:
 // - the default output (confirmed tracks, the config's score thresholds), OUT/data/SSSS.txt:
 //   MOTA, MOTP, IDSW, FRAG, FP, FN, HOTA: what a user of the tracker gets;
 // - every track of every detection (output all, no score threshold), each row with its track's

@@ -1,5 +1,5 @@
 // Where the velocity error comes from: the matched pairs' velocity errors grouped by the track's
-// age, the label's class, whether the label moves, and the part of the sequence (issue 15 asks
+// age, the label's class, whether the label moves, and the part of the sequence (the evaluation asks
 // for this breakdown; a single RMSE hides whether young tracks or one bad stretch dominate it).
 #pragma once
 

@@ -1,4 +1,4 @@
-// dlslot-sim: writes a synthetic KITTI tracking sequence with exact ground truth (issue 3).
+// dlslot-sim: writes a synthetic KITTI tracking sequence with exact ground truth.
 //   dlslot-sim --scenario NAME|FILE.yaml --out DIR [--frames N] [--seed S] [--sequence 0000] [--threads T]
 #include <algorithm>
 #include <cstdio>

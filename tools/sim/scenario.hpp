@@ -84,7 +84,7 @@ struct EgoSpec {
   PathSpec path;
   double start_s_m = 0.0;
   std::vector<std::pair<double, double>> speed_profile;  // (time s, speed m/s) knots
-  // The body's ride on its suspension (issue 15): rms pitch and roll (rad) and rms heave (m), each a
+  // The body's ride on its suspension: rms pitch and roll (rad) and rms heave (m), each a
   // sum of three sinusoids of 0.7-2.5 Hz with seeded phases. The lidar turns with the body, during
   // the sweep too. 0 = a rigid ride.
   double body_pitch_roll = 0.5 * M_PI / 180.0;
@@ -101,7 +101,7 @@ struct TrafficSpec {
   double stop_probability = 0.0;  // chance an agent stops for a while somewhere
 };
 
-struct SensorSpec {  // HDL-64E-like (issue 3); the imperfections of a real one (issue 15), see sensor_model.hpp
+struct SensorSpec {  // HDL-64E-like; the imperfections of a real one, see sensor_model.hpp
   int azimuth_steps = 2000;
   double max_range_m = 120.0, min_range_m = 2.5;
   double height_m = 1.73;

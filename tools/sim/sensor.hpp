@@ -1,7 +1,6 @@
-// The HDL-64E-like lidar (issue 3): 64 beams at the HDL-64E's vertical angles, `azimuth_steps`
+// The HDL-64E-like lidar: 64 beams at the HDL-64E's vertical angles, `azimuth_steps`
 // columns a revolution, intensity from the surface's reflectivity and the angle of incidence; with
-// a real one's imperfections (issue 15, sensor_model.hpp, each switchable in the scenario): a
-// firing phase that changes every revolution, per-beam calibration residuals (the rays leave at
+// a real one's imperfections (sensor_model.hpp, each switchable in the scenario): a firing phase that changes every revolution, per-beam calibration residuals (the rays leave at
 // angles the stored points do not have), range noise growing with range and incidence, weak
 // returns lost, motion distortion (each column fired at its time in the 0.1 s sweep while the ego
 // and the objects move) and porous foliage and fences. Points are written ring by ring from the

@@ -1,4 +1,4 @@
-// The imperfections of a real HDL-64E that make LiDAR odometry drift (issue 15), as pure functions
+// The imperfections of a real HDL-64E that make LiDAR odometry drift, as pure functions
 // the ray caster (sensor.cpp) calls and the tests check against: firing that is not locked to the
 // rotation, per-beam calibration residuals, range noise growing with range and incidence, returns
 // lost when the received signal is weak, and the sweep's 0.1 s of motion.
@@ -12,7 +12,7 @@
 
 namespace dlslot::sim {
 
-// The same sensor without the imperfections of issue 15 (the ideal lidar of issue 3: nominal
+// The same sensor without the imperfections (the ideal lidar: nominal
 // angles, fixed firing, constant range noise, random dropout only, instantaneous, solid foliage).
 SensorSpec idealSensor(SensorSpec sensor);
 

@@ -18,6 +18,7 @@
 
 #include "dlslot/frame_accounting.hpp"
 #include "dlslot/input_error.hpp"
+#include "dlslot/large_message_filter.hpp"
 #include "dlslot/receive_buffer.hpp"
 
 namespace dlslot {
@@ -261,15 +262,30 @@ Node::Node(std::string name, const std::string& lcm_url, const Channels& channel
                              (lcm_url.empty() ? std::string("(default)") : lcm_url) + "'");
   const char* env = std::getenv("LCM_DEFAULT_URL");
   const std::string url = !lcm_url.empty() ? lcm_url : env ? env : "";
-  if (const int64_t want = requestedReceiveBuffer(url); want > 0) {
-    lcm_.getFileno();  // creates LCM's receive socket (it is otherwise made on first use)
-    const ReceiveBuffer rb = enlargeLcmReceiveBuffer(lcmPort(url), want);
-    recv_fd_ = rb.fd;
-    status_.set("recv_buffer_bytes", rb.granted);
-    std::fprintf(stderr, "[%s] %s\n", name_.c_str(), rb.note.c_str());
+  if (const int port = lcmPort(url); port > 0) {
+    // LCM's receive socket is the one that appears when LCM makes it (on first use): any other on
+    // the port was inherited (dlslot-run's children hold the launcher's, a test's launcher the
+    // test's), and a filter or buffer size set on it would act on the other process's socket.
+    const std::vector<int> before = udpSocketsOnPort(port);
+    lcm_.getFileno();
+    for (const int fd : udpSocketsOnPort(port))
+      if (std::find(before.begin(), before.end(), fd) == before.end()) recv_fd_ = fd;
+  }
+  if (recv_fd_ >= 0) {
+    if (const int64_t want = requestedReceiveBuffer(url); want > 0) {
+      const ReceiveBuffer rb = enlargeReceiveBuffer(recv_fd_, want);
+      status_.set("recv_buffer_bytes", rb.granted);
+      std::fprintf(stderr, "[%s] %s\n", name_.c_str(), rb.note.c_str());
+    }
+    // No subscription yet, so no point cloud is wanted until one subscribes to the scan channel.
+    filtering_large_ = attachLargeMessageFilter(recv_fd_);
   }
   // The player's start events, for every node (handleRunEvent).
   subscribe<run_event_t>(channels_.run_event, [this](const run_event_t& e) { handleRunEvent(e); });
+}
+
+void Node::noteSubscription(const std::string& channel) {
+  if (channel == channels_.scan && filtering_large_) filtering_large_ = !detachLargeMessageFilter(recv_fd_);
 }
 
 void Node::handleRunEvent(const run_event_t& e) {
@@ -298,7 +314,15 @@ void Node::noteFrameReceived(int frame) {
   if (frames_received_.insert(frame).second) status_.count("frames_received");
 }
 
+void Node::checkSize(const std::string& channel, int64_t bytes) {
+  if (bytes >= kLargeMessageBytes)
+    status_.error("a message on " + channel + " is " + std::to_string(bytes) +
+                  " bytes: processes that take no scans do not receive messages of " +
+                  std::to_string(kLargeMessageBytes) + " bytes or more (large_message_filter.hpp)");
+}
+
 void Node::subscribeRaw(const std::string& channel, RawHandler cb) {
+  noteSubscription(channel);
   for (ChannelHandlers& h : handlers_)
     if (h.channel == channel) {
       h.handlers.push_back(std::move(cb));
@@ -336,6 +360,7 @@ void Node::publishSealed(const std::string& channel, size_t payload_size) {
 }
 
 void Node::publishEncoded(const std::string& channel, const void* data, size_t size) {
+  if (channel != channels_.scan) checkSize(channel, static_cast<int64_t>(size));
   out_buf_.resize(auth_.headerBytes() + size + auth_.tagBytes());
   if (size) std::memcpy(out_buf_.data() + auth_.headerBytes(), data, size);
   publishSealed(channel, size);
@@ -364,7 +389,9 @@ void Node::handleOnce(double max_wait_s) {
   double wait = max_wait_s;
   for (const Timer& t : timers_) wait = std::min(wait, std::chrono::duration<double>(t.next - now).count());
   pollfd pfd{lcm_.getFileno(), POLLIN, 0};
-  int timeout_ms = std::max(0, static_cast<int>(wait * 1000.0));
+  // Rounded up: rounded down, the last millisecond before every timer was a loop of poll(0)
+  // calls (the backend's 10 ms timer kept a fifth of its CPU time in poll).
+  const int timeout_ms = std::max(0, static_cast<int>(std::ceil(wait * 1000.0)));
   if (poll(&pfd, 1, timeout_ms) > 0 && (pfd.revents & POLLIN)) lcm_.handle();
 
   now = Clock::now();

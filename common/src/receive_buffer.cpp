@@ -40,8 +40,9 @@ int lcmPort(const std::string& lcm_url) {
 
 namespace {
 
-// Every open UDP socket of this process bound to `port`.
-std::vector<int> socketsOnPort(int port) {
+}  // namespace
+
+std::vector<int> udpSocketsOnPort(int port) {
   std::vector<int> out;
   DIR* dir = opendir("/proc/self/fd");
   if (!dir) return out;
@@ -62,6 +63,8 @@ std::vector<int> socketsOnPort(int port) {
   return out;
 }
 
+namespace {
+
 int64_t readBuffer(int fd) {
   int v = 0;
   socklen_t len = sizeof v;
@@ -78,14 +81,20 @@ std::string mb(int64_t bytes) {
 }  // namespace
 
 ReceiveBuffer enlargeLcmReceiveBuffer(int port, int64_t bytes) {
-  ReceiveBuffer r;
-  r.requested = bytes;
-  const std::vector<int> fds = socketsOnPort(port);
+  const std::vector<int> fds = udpSocketsOnPort(port);
   if (fds.empty()) {
+    ReceiveBuffer r;
+    r.requested = bytes;
     r.note = "no LCM multicast receive socket found; receive buffer left as it is";
     return r;
   }
-  r.fd = fds.front();
+  return enlargeReceiveBuffer(fds.front(), bytes);
+}
+
+ReceiveBuffer enlargeReceiveBuffer(int fd, int64_t bytes) {
+  ReceiveBuffer r;
+  r.requested = bytes;
+  r.fd = fd;
   const int want = static_cast<int>(std::min<int64_t>(bytes, 1 << 30));
   r.forced = setsockopt(r.fd, SOL_SOCKET, SO_RCVBUFFORCE, &want, sizeof want) == 0;
   if (!r.forced) setsockopt(r.fd, SOL_SOCKET, SO_RCVBUF, &want, sizeof want);

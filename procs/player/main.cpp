@@ -11,8 +11,8 @@
 #include "dlslot/input_error.hpp"
 #include "dlslot/kitti.hpp"
 #include "dlslot/node.hpp"
-#include "dlslot/point_cloud_t.hpp"
 #include "dlslot/progress.hpp"
+#include "dlslot/scan_encoding.hpp"
 #include "playback.hpp"
 
 using namespace dlslot;
@@ -105,6 +105,7 @@ int run(int argc, char** argv) {
   std::optional<player::RatePacer> pacer;
   const auto t0 = Node::Clock::now();
   int played = 0;
+  std::vector<uint8_t> scan_bytes;  // LIDAR_SCAN's encoding, one buffer for the whole run
   for (int i = range.start; i <= range.end && !signalReceived(); ++i) {
     const auto tic = Node::Clock::now();
     Frame frame = reader.read(i);
@@ -115,12 +116,8 @@ int run(int argc, char** argv) {
       node.spinUntil([&] { return Node::Clock::now() >= due; }, 1e9);
     }
 
-    point_cloud_t scan;
-    scan.utime = frame.utime;
-    scan.frame = frame.index;
-    scan.sequence = sequence;
-    toMsg(frame.scan, scan);
-    node.publish(channels.scan, scan);
+    encodeScan(frame.scan, frame.utime, frame.index, sequence, scan_bytes);
+    node.publishEncoded(channels.scan, scan_bytes.data(), scan_bytes.size());
 
     if (!no_detections) {
       detections_t det;

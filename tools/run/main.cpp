@@ -9,6 +9,9 @@
 // everything cleanly, runs the evaluator, and accounts for every played frame per process
 // (frame_accounting.hpp): a run that lost frames says so in its last line and exits 4 unless
 // --allow-loss. Run it inside scripts/netns-run (./dlslot run does) unless --lcm-url is given.
+// --foxglove [PORT] also starts dlslot-foxglove, the live Foxglove bridge (not counted in the
+// frame accounting: it only watches).
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -85,7 +88,22 @@ struct Failure : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// "--foxglove" may come without its port: the default port is put in, so the option parser
+// (which wants a value) sees "--foxglove 8765".
+std::vector<std::string> withFoxglovePort(int argc, char** argv) {
+  std::vector<std::string> a(argv, argv + argc);
+  for (size_t i = 1; i < a.size(); ++i)
+    if (a[i] == "--foxglove" && (i + 1 == a.size() || a[i + 1].rfind("--", 0) == 0)) a.insert(a.begin() + i + 1, "8765");
+  return a;
+}
+
 int runPipeline(int argc, char** argv) {
+  std::vector<std::string> arg_text = withFoxglovePort(argc, argv);
+  std::vector<char*> arg_ptrs;
+  for (auto& a : arg_text) arg_ptrs.push_back(a.data());
+  argc = static_cast<int>(arg_ptrs.size());
+  argv = arg_ptrs.data();
+  int foxglove_port = -1;
   std::string root, sequence = "0000", scenario, mode = "slot", config = "config/dlslot.yaml", out, lcm_url, detector;
   std::vector<std::string> detections;
   constexpr int kNotGiven = std::numeric_limits<int>::min();
@@ -120,7 +138,10 @@ int runPipeline(int argc, char** argv) {
             "default: a fresh key per run, kept as run.key in --out");
   cl.flag("--insecure", &insecure, "no message authentication: any host on the LCM URL can publish into the run");
   cl.option("--make-key", &make_key, "write a fresh key file (0600) for --key and exit");
+  cl.option("--foxglove", &foxglove_port,
+            "[PORT] also serve the live run to Foxglove (dlslot-foxglove, WebSocket on 127.0.0.1:PORT, default 8765)");
   if (!cl.parse(argc, argv)) return 0;
+  const bool foxglove = foxglove_port >= 0;
   if (!make_key.empty()) {
     const RunKey key = makeRunKey();
     writeKeyFile(make_key, key);
@@ -179,8 +200,8 @@ int runPipeline(int argc, char** argv) {
     ConfigSection cfg = loadConfig(config);  // throws a clear ConfigError
     (void)cfg;
     fs::copy_file(config, out + "/config.yaml", fs::copy_options::overwrite_existing);
-    for (const std::string p : {"player", "detector", "odometry", "tracker", "backend", "renderer"}) {
-      if ((no_render && p == "renderer") || (!geometric && p == "detector")) continue;
+    for (const std::string p : {"player", "detector", "odometry", "tracker", "backend", "renderer", "foxglove"}) {
+      if ((no_render && p == "renderer") || (!geometric && p == "detector") || (!foxglove && p == "foxglove")) continue;
       const std::string log = logs + "/check-" + p + ".log";
       if (runToEnd(sup, "check-" + p, {bin + "/dlslot-" + p, "--config", config, "--check-config"}, log) != 0)
         throw ConfigError("dlslot-" + p + " refused the config:\n" + run::readText(log));
@@ -271,6 +292,19 @@ int runPipeline(int argc, char** argv) {
     pipeline.push_back("detector");
     sup.start("detector", args(bin + "/dlslot-detector", {}), logs + "/detector.log");
   }
+  // The frames every pipeline process must account for; the bridge only watches.
+  const std::vector<std::string> accounted(pipeline.rbegin(), pipeline.rend());
+  if (foxglove) {
+    pipeline.push_back("foxglove");
+    sup.start("foxglove", args(bin + "/dlslot-foxglove", {"--port", std::to_string(foxglove_port)}),
+              logs + "/foxglove.log");
+    std::cerr << "foxglove: live bridge on ws://127.0.0.1:" << foxglove_port << " (Foxglove: Open connection -> "
+              << "Foxglove WebSocket)";
+    if (const char* ns = std::getenv("DLSLOT_NETNS"); ns && std::string(ns) == "private")
+      std::cerr << "; it is inside this run's private network namespace: to reach it from this machine give "
+                   "--lcm-url 'udpm://239.255.76.67:7667?ttl=0'";
+    std::cerr << "\n";
+  }
 
   auto failIfDead = [&](const std::string& except) {
     while (auto e = sup.reap()) {
@@ -322,8 +356,7 @@ int runPipeline(int argc, char** argv) {
                     " s though it is still running (stopped or hung); its last frame " +
                     std::to_string(h == health.end() ? -1 : h->second.last_frame) + "; its last lines (" +
                     sup.logPath(p) + "):\n" + sup.tail(p) + "\nframes so far (from the last PROCESS_STATUS of each):\n" +
-                    accountFrames(health, last_frame + 1, std::vector<std::string>(pipeline.rbegin(), pipeline.rend()))
-                        .table());
+                    accountFrames(health, last_frame + 1, accounted).table());
     }
   };
   std::vector<std::string> play = {"--kitti", root, "--sequence", sequence, "--quiet", "--delay", "0.2",
@@ -390,8 +423,10 @@ int runPipeline(int argc, char** argv) {
   // logger closes the log).
   // The launcher keeps reading while it waits, so each process's last PROCESS_STATUS is heard.
   const auto listen = [&] { node.spinUntil([] { return false; }, 0.02); };
-  for (const std::string p : {"detector", "odometry", "tracker", "backend", "renderer"}) {
-    if ((p == std::string("renderer") && no_render) || (p == std::string("detector") && !geometric)) continue;
+  for (const std::string p : {"detector", "odometry", "tracker", "backend", "renderer", "foxglove"}) {
+    if ((p == std::string("renderer") && no_render) || (p == std::string("detector") && !geometric) ||
+        (p == std::string("foxglove") && !foxglove))
+      continue;
     const int code = sup.stop(p, p == std::string("renderer") ? 60.0 : 10.0, listen);
     if (code != 0) throw Failure(p + " did not exit cleanly (code " + std::to_string(code) + "):\n" + sup.tail(p));
   }
@@ -411,8 +446,8 @@ int runPipeline(int argc, char** argv) {
   // Where the two cores went: each process's CPU time over the whole run, per played frame.
   {
     std::string line;
-    for (const std::string p : {"odometry", "tracker", "backend", "renderer", "player", "lcm-logger"}) {
-      if (p == std::string("renderer") && no_render) continue;
+    for (const std::string p : {"odometry", "tracker", "backend", "renderer", "foxglove", "player", "lcm-logger"}) {
+      if ((p == std::string("renderer") && no_render) || (p == std::string("foxglove") && !foxglove)) continue;
       const double s = sup.cpuSeconds(p);
       if (s < 0) continue;
       char buf[96];
@@ -427,8 +462,7 @@ int runPipeline(int argc, char** argv) {
                last_frame + 1, play_s > 0 ? slot_frames / play_s : 0.0, speed > 0 ? "rate mode" : "lockstep");
   if (slot_frames != last_frame + 1) std::cerr << "warning: frames are missing from SLOT_STATE\n";
   // Where every frame went, and the memory of each process over the run.
-  const FrameAccounting accounting =
-      accountFrames(health, last_frame + 1, std::vector<std::string>(pipeline.rbegin(), pipeline.rend()));
+  const FrameAccounting accounting = accountFrames(health, last_frame + 1, accounted);
   std::cerr << accounting.table();
   std::cerr << "memory (RSS MB, start / middle / end):\n";
   for (const auto& [p, samples] : rss)

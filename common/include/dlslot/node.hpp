@@ -129,6 +129,7 @@ class Node {
   template <class Msg>
   void publish(const std::string& channel, const Msg& msg) {
     const int size = msg.getEncodedSize();
+    if (channel != channels_.scan) checkSize(channel, size);
     out_buf_.resize(auth_.headerBytes() + static_cast<size_t>(size) + auth_.tagBytes());
     if (msg.encode(out_buf_.data() + auth_.headerBytes(), 0, size) != size) {
       status_.error("encoding a message for " + channel + " failed");
@@ -165,6 +166,10 @@ class Node {
   void noteFrameReceived(int frame);
   void publishSealed(const std::string& channel, size_t payload_size);
   void dispatch(const std::string& channel, const lcm::ReceiveBuffer& rbuf);
+  void noteSubscription(const std::string& channel);
+  // A message this large on a channel other than the scan is trimmed away by the large-message
+  // filter of every process that takes no scans (large_message_filter.hpp): reported as an error.
+  void checkSize(const std::string& channel, int64_t bytes);
   struct Timer {
     Clock::time_point next;
     double period_s;  // 0 = one-shot
@@ -190,6 +195,7 @@ class Node {
     std::vector<RawHandler> handlers;
   };
   std::list<ChannelHandlers> handlers_;
+  bool filtering_large_ = false;  // the large-message filter is on recv_fd_ (no scan subscription)
   bool stop_ = false;
 };
 

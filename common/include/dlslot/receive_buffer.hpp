@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace dlslot {
 
@@ -25,9 +26,16 @@ struct ReceiveBuffer {
   std::string note;       // one line saying what was asked and what was granted, and how
 };
 
-// Finds this process's UDP socket bound to `port` (LCM's receive socket: create it first, e.g.
-// with lcm::LCM::getFileno(); LCM's sending socket is not bound to it) and asks for `bytes`:
-// SO_RCVBUFFORCE, else SO_RCVBUF.
+// Every open UDP socket of this process bound to `port`, in fd order. It may hold sockets that
+// another process made (descriptors inherited across fork and exec: dlslot-run's children hold
+// the launcher's): Node tells its own by the socket that appears when LCM makes it.
+std::vector<int> udpSocketsOnPort(int port);
+
+// Asks for `bytes` of kernel receive buffer on socket `fd`: SO_RCVBUFFORCE, else SO_RCVBUF.
+ReceiveBuffer enlargeReceiveBuffer(int fd, int64_t bytes);
+// The same on the first UDP socket of this process bound to `port` (LCM's receive socket when it
+// is the process's only one: create it first, e.g. with lcm::LCM::getFileno(); LCM's sending
+// socket is not bound to the port).
 ReceiveBuffer enlargeLcmReceiveBuffer(int port, int64_t bytes);
 
 // Datagrams the kernel dropped on socket `fd` since it was opened (/proc/net/udp, the "drops"

@@ -170,7 +170,9 @@ TEST(BackendNode, OfflineReplayOnTheTrueEgo) {
   const slot_state_t& last = states.back();
   ASSERT_EQ(last.num_tracks, 2);
   for (const track_t& tr : last.tracks)
-    if (tr.id == 2) EXPECT_NEAR(std::hypot(tr.velocity[0], tr.velocity[1]), 12.0, 0.5);
+    if (tr.id == 2) {
+      EXPECT_NEAR(std::hypot(tr.velocity[0], tr.velocity[1]), 12.0, 0.5);
+    }
 
   // Fewer poses than frames: an error naming the file and the frame.
   truth.resize(20);

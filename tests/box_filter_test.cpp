@@ -33,7 +33,9 @@ TEST(BoxFilter, EqualsTestingEveryPointAgainstEveryBox) {
         ASSERT_EQ(inside[i], expected) << "point " << i << ", " << n << " boxes, margin " << margin;
         count += expected;
       }
-      if (n == 25) EXPECT_GT(count, 100);
+      if (n == 25) {
+        EXPECT_GT(count, 100);
+      }
     }
   }
 }

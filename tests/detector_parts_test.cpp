@@ -29,12 +29,11 @@ std::vector<Eigen::Vector2f> lShape(const Eigen::Vector2d& c, double l, double w
   std::normal_distribution<double> n(0.0, noise);
   const Eigen::Vector2d u(std::cos(yaw), std::sin(yaw)), v(-u.y(), u.x());
   // The corner nearest the origin, and the two sides from it.
-  Eigen::Vector2d corner;
-  double best = 1e9;
+  Eigen::Vector2d corner = c - 0.5 * l * u - 0.5 * w * v;
   for (int a : {-1, 1})
     for (int b : {-1, 1}) {
       const Eigen::Vector2d p = c + a * 0.5 * l * u + b * 0.5 * w * v;
-      if (p.norm() < best) best = p.norm(), corner = p;
+      if (p.norm() < corner.norm()) corner = p;
     }
   const Eigen::Vector2d along = (c - corner).dot(u) > 0 ? u : Eigen::Vector2d(-u), across = (c - corner).dot(v) > 0 ? v : Eigen::Vector2d(-v);
   std::vector<Eigen::Vector2f> pts;

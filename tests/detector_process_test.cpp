@@ -90,6 +90,15 @@ TEST(DetectorProcess, ScansInDetectionsOutFaultsCounted) {
     EXPECT_EQ(d.source, "geometric");
     EXPECT_EQ(d.num_boxes, static_cast<int32_t>(d.boxes.size()));
     EXPECT_EQ(d.utime, 1000000 + d.frame * 100000);
+    // Its stages and the whole callback, for the run's timing table (timing_ms.detector.*).
+    std::vector<std::string> stages;
+    for (const stage_timing_t& t : d.timings) {
+      stages.push_back(t.name);
+      EXPECT_GE(t.ms, 0.0) << t.name;
+    }
+    EXPECT_EQ(d.num_timings, static_cast<int32_t>(d.timings.size()));
+    EXPECT_EQ(stages, (std::vector<std::string>{"layout", "ground", "clustering", "boxes", "total"}))
+        << "frame " << d.frame;
   }
   EXPECT_EQ(listen.detections[1].num_boxes, 0);
   for (const detections_t* d : {&listen.detections[0], &listen.detections[2]}) {

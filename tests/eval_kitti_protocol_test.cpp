@@ -144,6 +144,17 @@ TEST(KittiProtocol, EveryIgnoreRuleOfTheDevkitGivesItsKnownCount) {
   EXPECT_FALSE(kitti::resultRow(0, behind, calib));
 }
 
+TEST(KittiProtocol, EachIdentitySwitchIsListedWithItsFrameAndTracks) {
+  // The hand-built car 1 goes from track 100 to 101 in frame 2: the one switch, listed.
+  const auto m = eval::evaluateKittiTracking({handBuilt()}).at("car");
+  ASSERT_EQ(m.best_switches.size(), 1u);
+  EXPECT_EQ(m.best_switches[0].sequence, "hand");
+  EXPECT_EQ(m.best_switches[0].frame, 2);
+  EXPECT_EQ(m.best_switches[0].label_id, 1);
+  EXPECT_EQ(m.best_switches[0].from, 100);
+  EXPECT_EQ(m.best_switches[0].to, 101);
+}
+
 TEST(KittiProtocol, SequencesArePooledAndKeepTheirOwnIds) {
   // Two copies of the hand-built sequence: every count doubles (the same label and track ids in the
   // second sequence are other objects: no switch between them), the ratios stay.

@@ -342,7 +342,9 @@ TEST_F(EvalLog, ExportedFilesEvaluateLikeTheLog) {
       const std::string k = std::string("tracking.") + cls + "." + key;
       const std::optional<double> a = value(log_json, k), b = value(json, k);
       ASSERT_EQ(a.has_value(), b.has_value()) << k;
-      if (a) EXPECT_NEAR(*a, *b, 1e-4) << k;  // the file holds 6 decimals
+      if (a) {  // the file holds 6 decimals
+        EXPECT_NEAR(*a, *b, 1e-4) << k;
+      }
     }
   EXPECT_DOUBLE_EQ(*value(json, "tracking.car.tp") + *value(json, "tracking.pedestrian.tp"), in_image);
   // Track velocities come from the tracks' positions and the system's poses: exact here.

@@ -328,6 +328,36 @@ TEST(EvalVelocity, EvaluateComparesTheSystemsVelocityWithGroundTruthMotion) {
   EXPECT_NE(m.velocity_frame.find("world"), std::string::npos);
 }
 
+TEST(EvalTracking, EveryClassIsScoredAllAroundOnItsOwn) {
+  // Two cars and a pedestrian labelled in 4 frames; the cars are tracked throughout, the
+  // pedestrian only in the last two frames, and a false pedestrian track appears once. Per class:
+  // car MOTA 1; pedestrian 2 misses + 1 false positive of 4 labels -> MOTA 0.25; no cyclist row.
+  RunData run;
+  run.has_labels = run.has_tracks = true;
+  for (int t = 0; t < 4; ++t) {
+    TrackingFrame f;
+    f.frame = t;
+    f.stamp = 0.1 * t;
+    f.truth = {obj(10, 0, 1), obj(20, 5, 2), obj(5, -3, 3, "Pedestrian")};
+    f.tracks = {obj(10.2, 0, 11), obj(20, 5.1, 12)};
+    if (t >= 2) f.tracks.push_back(obj(5.1, -3, 13, "Pedestrian"));
+    if (t == 0) f.tracks.push_back(obj(-8, 9, 14, "Pedestrian"));
+    run.tracking.push_back(f);
+  }
+  const Metrics m = evaluate(run, EvalOptions());
+  ASSERT_EQ(m.tracking_by_class.size(), 2u);
+  const ClearMot& car = m.tracking_by_class.at("car");
+  EXPECT_EQ(car.num_truth, 8);
+  EXPECT_EQ(car.tp, 8);
+  EXPECT_NEAR(*car.mota, 1.0, 1e-12);
+  const ClearMot& ped = m.tracking_by_class.at("pedestrian");
+  EXPECT_EQ(ped.num_truth, 4);
+  EXPECT_EQ(ped.fn, 2);
+  EXPECT_EQ(ped.fp, 1);
+  EXPECT_NEAR(*ped.mota, 0.25, 1e-12);
+  EXPECT_EQ(m.tracking_by_class.count("cyclist"), 0u);
+}
+
 TEST(EvalTracking, VelocityErrorsAreBrokenDownByAgeClassMotionAndStretch) {
   // One car tracked from frame 0, a van from frame 10, a parked car; 20 frames. The car's track is
   // 1 m/s off along x, the van's 2 m/s, the parked car's 0.5 m/s.

@@ -131,7 +131,7 @@ TEST(OdometryProcess, FaultsDoNotStopIt) {
       lcm.publish("LIDAR_SCAN", garbage, sizeof garbage);
     }
     if (f != 2) {  // DETECTIONS of scan 2 never come
-      detections_t det;
+      detections_t det{};
       det.utime = scan.utime;
       det.frame = f;
       det.boxes.push_back(toMsg(car));

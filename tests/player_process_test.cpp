@@ -151,7 +151,7 @@ TEST(PlayerProcess, LockstepWaitsForTheConsumerAndReportsTimeouts) {
         c->seen->push_back(scan.frame);
         if (scan.frame == 2) return;
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
-        detections_t ack;
+        detections_t ack{};
         ack.utime = scan.utime;
         ack.frame = scan.frame;
         ack.num_boxes = 0;

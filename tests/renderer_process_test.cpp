@@ -70,7 +70,7 @@ std::vector<Event> smallRun() {
     toMsg(scan, pc);
     events.push_back(encoded("LIDAR_SCAN", pc));
 
-    detections_t det;
+    detections_t det{};
     det.utime = utime;
     det.frame = f;
     det.boxes = {toMsg(car)};

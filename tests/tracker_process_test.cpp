@@ -75,7 +75,7 @@ TEST(TrackerProcess, LockstepFramesWithFaults) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (int f : frames) {
     const Pose X = egoAt(f);
-    detections_t det;
+    detections_t det{};
     det.utime = 1000000 + f * 100000;
     det.frame = f;
     if (f != 5) {  // scan 5 has no detections

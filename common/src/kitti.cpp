@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -301,7 +302,17 @@ void writeTrackingLabels(const std::string& path, const std::vector<LabelRow>& r
                  r.track_id, r.type.c_str(), r.truncated, r.occluded, r.alpha, r.bbox2d[0], r.bbox2d[1],
                  r.bbox2d[2], r.bbox2d[3], r.box.h, r.box.w, r.box.l, r.box.bottom_center.x(),
                  r.box.bottom_center.y(), r.box.bottom_center.z(), r.box.rotation_y);
-    if (r.score) std::fprintf(f, " %.6f", *r.score);
+    if (r.score) {
+      // Six decimals when they read back as the same number, else as many digits as that takes:
+      // evaluators average a track's scores and compare the mean with other tracks' (sAMOTA), and
+      // a value that does not survive the round trip ranks differently there than it did here.
+      char six[64];
+      std::snprintf(six, sizeof six, "%.6f", *r.score);
+      if (std::strtod(six, nullptr) == *r.score)
+        std::fprintf(f, " %s", six);
+      else
+        std::fprintf(f, " %.17g", *r.score);
+    }
     std::fprintf(f, "\n");
   }
   closeWrite(f, path);

@@ -232,7 +232,7 @@ Refusal checkLayout(const point_cloud_t*, const void* data, size_t size) {
 
 Refusal checkLayout(const detections_t*, const void* data, size_t size) {
   Cursor c(data, size);
-  (void)(header(c, detections_t::getHash()) && c.str("source") && boxes(c, "num_boxes"));
+  (void)(header(c, detections_t::getHash()) && c.str("source") && boxes(c, "num_boxes") && timings(c));
   return c.finish();
 }
 
@@ -308,7 +308,7 @@ Refusal checkContent(const detections_t& m) {
   if (Refusal r = checkUtime(m.utime)) return r;
   for (size_t i = 0; i < m.boxes.size(); ++i)
     if (Refusal r = checkDetectedBox(m.boxes[i], fieldAt("boxes", i))) return r;
-  return {};
+  return checkTimings(m.timings);
 }
 
 Refusal checkContent(const ground_truth_t& m) {

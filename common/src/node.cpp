@@ -1,6 +1,7 @@
 #include "dlslot/node.hpp"
 
 #include <poll.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -140,12 +141,56 @@ void useNoKey() { unsetenv(kKeyFileEnv); }
 
 // ---------------- ProcessStatus ----------------
 
+namespace {
+
+double processCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+// DLSLOT_SLOWDOWN=NAME:FRACTION[,NAME:FRACTION...]: the fraction of extra CPU time the process
+// named NAME burns per frame (0 when not named or malformed).
+double slowdownFor(const std::string& name) {
+  const char* env = std::getenv("DLSLOT_SLOWDOWN");
+  if (!env) return 0;
+  for (const std::string& item : splitList(env)) {
+    const size_t colon = item.find(':');
+    if (colon == std::string::npos || item.substr(0, colon) != name) continue;
+    char* end = nullptr;
+    const double f = std::strtod(item.c_str() + colon + 1, &end);
+    if (end && *end == '\0' && f > 0 && f < 100) return f;
+    std::fprintf(stderr, "[%s] DLSLOT_SLOWDOWN: '%s' is not NAME:FRACTION; ignored\n", name.c_str(), item.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
 ProcessStatus::ProcessStatus(std::string name) : name_(std::move(name)) {}
 
 void ProcessStatus::frameDone(int frame, double ms) {
   ++frames_;
   last_frame_ = frame;
   times_.add(ms);
+  // Test hook of the speed guard (./dlslot bench, docs/performance.md): DLSLOT_SLOWDOWN=NAME:FRACTION
+  // makes the process whose (first) status is NAME burn that fraction of its CPU time since the
+  // previous frame (every thread's) in a loop, so its CPU per frame grows by the fraction.
+  static const double slowdown = [this] {
+    const double f = slowdownFor(name_);
+    if (f > 0)
+      std::fprintf(stderr, "[%s] DLSLOT_SLOWDOWN: burning %.0f %% more CPU time per frame (a test of the speed guard)\n",
+                   name_.c_str(), 100 * f);
+    return f;
+  }();
+  static double cpu_at_last_frame = processCpuSeconds();
+  if (slowdown > 0) {
+    const double now = processCpuSeconds();
+    const double until = now + slowdown * (now - cpu_at_last_frame);
+    volatile double sink = 0;
+    while (processCpuSeconds() < until) sink = sink + 1;
+    cpu_at_last_frame = processCpuSeconds();
+  }
 }
 
 void ProcessStatus::decodeError(const std::string& channel) {

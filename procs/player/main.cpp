@@ -3,6 +3,7 @@
 // --no-detections, when dlslot-detector makes them) and GROUND_TRUTH (when the data set has labels
 // or poses), at a rate or in lockstep with a downstream channel.
 #include <cstdio>
+#include <deque>
 #include <iostream>
 
 #include "dlslot/convert.hpp"
@@ -43,7 +44,7 @@ int run(int argc, char** argv) {
   std::string root, sequence, lockstep;
   std::vector<std::string> detections;
   double speed = 1.0, delay_s = 0.5;
-  int start = 0, end = -1;
+  int start = 0, end = -1, in_flight = 1;
   bool quiet = false, no_detections = false;
   CommandLine cl("dlslot-player", "Plays a KITTI sequence over LCM (LIDAR_SCAN, DETECTIONS, GROUND_TRUTH).");
   cl.option("--kitti", &root, "KITTI root (holding training/ or sequences/)");
@@ -51,6 +52,9 @@ int run(int argc, char** argv) {
   cl.repeated("--detections", &detections, "detection file or directory (tracking format or comma-separated)");
   cl.option("--speed", &speed, "rate mode: real time x this factor; 0 = as fast as possible (default 1)");
   cl.option("--lockstep", &lockstep, "publish frame t+1 only after CHANNEL carried frame t");
+  cl.option("--in-flight", &in_flight,
+            "lockstep: frames published and not yet carried by CHANNEL, at most (default 1: frame t+1 after "
+            "CHANNEL carried t; 2: after it carried t-1, so the odometry of t+1 runs while the backend solves t)");
   cl.option("--start", &start, "first frame (default 0)");
   cl.option("--end", &end, "last frame, inclusive (default: last)");
   cl.option("--delay", &delay_s, "seconds to wait before the first frame, for subscribers to start (default 0.5)");
@@ -67,6 +71,7 @@ int run(int argc, char** argv) {
   if (node_opts.check_config) return 0;
   if (root.empty()) throw std::invalid_argument("--kitti ROOT is required");
   if (sequence.empty()) throw std::invalid_argument("--sequence SSSS is required");
+  if (in_flight < 1) throw std::invalid_argument("--in-flight: expected an integer >= 1, got " + std::to_string(in_flight));
   if (no_detections && !detections.empty())
     throw std::invalid_argument("--no-detections and --detections exclude each other");
 
@@ -106,6 +111,7 @@ int run(int argc, char** argv) {
   const auto t0 = Node::Clock::now();
   int played = 0;
   std::vector<uint8_t> scan_bytes;  // LIDAR_SCAN's encoding, one buffer for the whole run
+  std::deque<int> unacked;          // lockstep: frames published, not yet carried by the channel
   for (int i = range.start; i <= range.end && !signalReceived(); ++i) {
     const auto tic = Node::Clock::now();
     Frame frame = reader.read(i);
@@ -120,7 +126,7 @@ int run(int argc, char** argv) {
     node.publishEncoded(channels.scan, scan_bytes.data(), scan_bytes.size());
 
     if (!no_detections) {
-      detections_t det;
+      detections_t det{};
       det.utime = frame.utime;
       det.frame = frame.index;
       det.boxes = toMsg(frame.detections);
@@ -145,10 +151,18 @@ int run(int argc, char** argv) {
     node.status().frameDone(frame.index, std::chrono::duration<double, std::milli>(Node::Clock::now() - tic).count());
     ++played;
 
-    if (!lockstep.empty() &&
-        !node.spinUntil([&] { return acked_frame >= frame.index; }, cfg.lockstep_timeout_s))
-      node.status().timeout(lockstep + " did not carry frame " + std::to_string(frame.index) + " within " +
-                            std::to_string(cfg.lockstep_timeout_s) + " s; continuing");
+    if (!lockstep.empty()) {
+      unacked.push_back(frame.index);
+      // The last frame waits for every frame still in flight: the run ends when all are through.
+      const size_t keep = i == range.end ? 0 : static_cast<size_t>(in_flight - 1);
+      while (unacked.size() > keep && !signalReceived()) {
+        const int f = unacked.front();
+        unacked.pop_front();
+        if (!node.spinUntil([&] { return acked_frame >= f; }, cfg.lockstep_timeout_s))
+          node.status().timeout(lockstep + " did not carry frame " + std::to_string(f) + " within " +
+                                std::to_string(cfg.lockstep_timeout_s) + " s; continuing");
+      }
+    }
     if (!quiet) progress.update(played);
   }
   if (!quiet) progress.finish(std::to_string(node.status().toMessage().timeouts) + " lockstep timeouts");

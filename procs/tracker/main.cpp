@@ -17,6 +17,7 @@
 #include "dlslot/slot_state_t.hpp"
 #include "ego_pose_chain.hpp"
 #include "offline_run.hpp"
+#include "slot_state_gate.hpp"
 #include "tracker_config.hpp"
 #include "trajectory_associator.hpp"
 
@@ -71,6 +72,7 @@ associations_t toMsg(const JoinedFrame& joined, const EgoPose& ego, const FrameA
   m.num_active_tracks = result.num_active_tracks;
   m.num_rejected = joined.a ? joined.a->num_rejected : 0;
   for (const Association& a : result.associations) {
+    if (a.suppressed) continue;  // its class's plausibility rules it out (counted in the status)
     association_t out;
     out.detection_index = joined.a->message_index[a.detection_index];
     out.track_id = a.track_id;
@@ -142,6 +144,10 @@ int run(int argc, char** argv) {
   cl.flag("--all-around", &off.all_around,
           "offline: also write tracks outside the camera image (2-D box -1), for labels all around the scan "
           "(simulated sequences); not for the KITTI devkit");
+  bool follow_slot_state = false;
+  cl.flag("--follow-slot-state", &follow_slot_state,
+          "associate a frame only after SLOT_STATE of the frame associated before it (or join_timeout_s): "
+          "the same poses as strict lockstep when the player keeps frames in flight (dlslot-player --in-flight)");
   if (!cl.parse(argc, argv)) return 0;
 
   Channels channels;
@@ -155,6 +161,7 @@ int run(int argc, char** argv) {
   TrajectoryAssociator associator(cfg.associator);
   EgoPoseChain ego_poses;
   Joiner joiner(cfg.join_timeout_s);
+  SlotStateGate<JoinedFrame> gate(follow_slot_state, cfg.join_timeout_s);
 
   auto process = [&](const JoinedFrame& joined) {
     const auto tic = Node::Clock::now();
@@ -186,6 +193,9 @@ int run(int argc, char** argv) {
     status.count("detections_untracked_type", result.skipped.untracked_type);
     status.count("detections_below_score", result.skipped.below_score);
     status.count("detections_duplicate", result.skipped.duplicate);
+    // Tracks whose class the window overruled, by reason.
+    status.count("tracks_relabelled_too_fast", result.class_decisions.relabelled_too_fast);
+    status.count("tracks_suppressed_too_fast", result.class_decisions.suppressed_too_fast);
 
     associations_t msg = toMsg(joined, ego, result);
     const double ms = std::chrono::duration<double, std::milli>(Node::Clock::now() - tic).count();
@@ -195,13 +205,23 @@ int run(int argc, char** argv) {
     status.frameDone(joined.frame, ms);
   };
   auto releaseReady = [&] {
-    for (const JoinedFrame& joined : joiner.release(secondsNow())) process(joined);
+    const double now = secondsNow();
+    for (JoinedFrame& joined : joiner.release(now)) gate.push(joined.frame, std::move(joined), now);
+    int without = 0;
+    const int waited_for = gate.waitingFor();
+    for (const auto& [frame, joined] : gate.release(now, &without)) process(joined);
+    if (without > 0) {
+      status.timeout(channels.slot_state + " for frame " + std::to_string(waited_for) + " not within " +
+                     seconds(cfg.join_timeout_s) + "; associating without it");
+      status.count("slot_state_missing", without);
+    }
   };
   // The player's explicit start event (Node::onRestart) is the only thing that starts it over:
   // an old or repeated frame is refused before it gets here.
   node.onRestart([&](const run_event_t&) {
     associator.reset();
     joiner.reset();
+    gate.reset();
     ego_poses = EgoPoseChain();
   });
 
@@ -225,6 +245,8 @@ int run(int argc, char** argv) {
   });
   node.subscribe<slot_state_t>(channels.slot_state, [&](const slot_state_t& msg) {
     ego_poses.addOptimized(msg.frame, fromMsg(msg.ego_pose));
+    gate.slotState(msg.frame);
+    releaseReady();
   });
   node.every(0.02, releaseReady);
   return node.run();

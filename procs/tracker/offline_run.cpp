@@ -1,10 +1,12 @@
 #include "offline_run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <stdexcept>
 
 #include "dlslot/input_error.hpp"
+#include "track_evidence.hpp"
 
 namespace dlslot::tracker {
 
@@ -37,7 +39,13 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
   if (static_cast<int>(ego_poses.size()) < reader.size())
     throw std::invalid_argument("ego poses: " + std::to_string(ego_poses.size()) + " for " +
                                 std::to_string(reader.size()) + " frames");
-  TrajectoryAssociator associator(config);
+  // Speeds over ground need ego poses: with none (every pose the identity, tracking in the sensor
+  // frame) a parked object moves at the ego's speed, so the class's speed limits cannot be judged.
+  AssociatorConfig cfg = config;
+  if (std::all_of(ego_poses.begin(), ego_poses.begin() + reader.size(),
+                  [](const Pose& X) { return X.matrix().isIdentity(0.0); }))
+    cfg.plausibility.clear();
+  TrajectoryAssociator associator(cfg);
   OfflineResult out;
   auto write = [&](int frame, const Box& box) {
     kitti::LabelRow row = kitti::unprojectedRow(frame, box, reader.calib());
@@ -49,6 +57,8 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
     if (all_around) out.tracks.push_back(std::move(row));
   };
   int max_id = -1;
+  std::map<int, TrackEvidence> evidence;
+  std::map<int, const ClassPolicy*> policy_of;
   for (int i = 0; i < reader.size(); ++i) {
     const Frame frame = reader.read(i);
     const auto tic = std::chrono::steady_clock::now();
@@ -58,11 +68,19 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
     out.skipped.untracked_type += r.skipped.untracked_type;
     out.skipped.below_score += r.skipped.below_score;
     out.skipped.duplicate += r.skipped.duplicate;
+    out.class_decisions.relabelled_too_fast += r.class_decisions.relabelled_too_fast;
+    out.class_decisions.suppressed_too_fast += r.class_decisions.suppressed_too_fast;
     for (const Association& a : r.associations) {
       ++out.associated;
       max_id = std::max(max_id, a.track_id);
+      evidence[a.track_id].add(frame.index, a.box_lidar.score);
+      policy_of.emplace(a.track_id, policyFor(config.classes, a.box_lidar.type));
       const bool confirmed = a.status == TrackStatus::Confirmed;
       out.confirmed += confirmed;
+      if (a.suppressed) {
+        ++out.suppressed_rows;
+        continue;
+      }
       if (output == TrackOutput::Confirmed && !confirmed) continue;
       Box box = a.box_lidar;
       box.id = a.track_id;
@@ -75,6 +93,8 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
     }
   }
   out.trajectories = max_id + 1;
+  // The score column: each track's evidence over its life (track_evidence.hpp).
+  writeTrackScores(out.tracks, evidence, policy_of);
   return out;
 }
 

@@ -12,7 +12,7 @@ TrackOutput trackOutputFromName(const std::string& name) {
 
 namespace {
 
-ClassPolicy readPolicy(const std::string& name, ConfigSection s) {
+ClassPolicy readPolicy(const std::string& name, ConfigSection s, ClassPlausibility& plausible) {
   ClassPolicy p;
   p.name = name;
   s.get("types", p.types);
@@ -26,7 +26,12 @@ ClassPolicy readPolicy(const std::string& name, ConfigSection s) {
   s.get("max_misses", p.max_misses);
   s.get("max_polynomial_degree", p.max_polynomial_degree);
   s.get("output_coasting_frames", p.output_coasting_frames);
+  s.get("max_speed_mps", plausible.max_speed_mps);  // .inf: no limit
+  s.get("too_fast_type", plausible.too_fast_type);
   s.finish();
+  if (!(plausible.max_speed_mps > 0))
+    throw ConfigError(s.file() + ": " + s.path() + ".max_speed_mps: expected > 0 (.inf for no limit), got " +
+                      std::to_string(plausible.max_speed_mps));
   return p;
 }
 
@@ -46,7 +51,8 @@ TrackerConfig TrackerConfig::read(ConfigSection s) {
   const std::string output = s.get<std::string>("output");
   ConfigSection classes = s.section("classes");
   a.classes.clear();
-  for (const std::string& name : classes.keys()) a.classes.push_back(readPolicy(name, classes.section(name)));
+  for (const std::string& name : classes.keys())
+    a.classes.push_back(readPolicy(name, classes.section(name), a.plausibility[name]));
   classes.finish();
   s.finish();
   try {

@@ -258,13 +258,33 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
     // The window of k frames now ends at t: o_{t-k+1} .. o_t.
     if (tr.window.front().frame <= frame - config_.window_frames) tr.window.erase(tr.window.begin());
     if (!a.new_track) tr.lifecycle.hit(detection_confidence, static_cast<int>(tr.window.size()), config_.classes[policy]);
-    tr.last_box = a.box_world;
     tr.last_frame = frame;
     tr.last_time_s = time_s;
     // Preliminary static/dynamic guess from the motion over the window (III-D).
     tr.displacement = windowDisplacement(tr.window);
     tr.is_dynamic = tr.displacement > config_.dynamic_displacement_m;
+    // The class over the window: a track moving faster than its class can is not of it.
+    if (tr.relabelled_as.empty() && !tr.suppressed) {
+      const auto rule = config_.plausibility.find(config_.classes[policy].name);
+      const double span = tr.window.back().time_s - tr.window.front().time_s;
+      if (rule != config_.plausibility.end() && span >= rule->second.min_span_s &&
+          tr.displacement / span > rule->second.max_speed_mps) {
+        if (rule->second.too_fast_type.empty()) {
+          tr.suppressed = true;
+          ++out.class_decisions.suppressed_too_fast;
+        } else {
+          tr.relabelled_as = rule->second.too_fast_type;
+          ++out.class_decisions.relabelled_too_fast;
+        }
+      }
+    }
+    if (!tr.relabelled_as.empty()) {
+      a.box_lidar.type = a.box_world.type = tr.relabelled_as;
+      a.relabelled = true;
+    }
+    a.suppressed = tr.suppressed;
 
+    tr.last_box = a.box_world;
     a.track_id = tr.id;
     a.num_observations = static_cast<int>(tr.window.size());
     a.displacement = tr.displacement;
@@ -283,7 +303,7 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
   for (int u = 0; u < U; ++u) {
     const Trajectory& tr = trajectories_[u];
     const int missed = frame - tr.last_frame;
-    if (assignment[u] >= 0 || !tr.lifecycle.confirmed() ||
+    if (assignment[u] >= 0 || !tr.lifecycle.confirmed() || tr.suppressed ||
         missed > config_.classes[tr.policy].output_coasting_frames)
       continue;
     CoastingTrack c;

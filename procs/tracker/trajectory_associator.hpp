@@ -1,6 +1,8 @@
 // Sliding-window trajectory association (paper III-B) with the tracking initialization of III-D.
 #pragma once
 
+#include <limits>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,6 +24,17 @@ Predictor predictorFromName(const std::string& name);  // "polynomial" | "last_p
 // Truck; pedestrian = Pedestrian, Person_sitting; cyclist = Cyclist.
 std::vector<ClassPolicy> defaultClassPolicies();
 
+// What a class's objects can plausibly do over a window, beyond a single detector vote: a track
+// moving faster than max_speed_mps (its least-squares velocity over the window, once the window
+// spans min_span_s) is not of this class. It is then re-labelled as `too_fast_type` (e.g. a
+// "pedestrian" at cyclist speed is a cyclist the detector has no class file for), or its rows are
+// suppressed when that is empty; the decision sticks to the track.
+struct ClassPlausibility {
+  double max_speed_mps = std::numeric_limits<double>::infinity();
+  std::string too_fast_type;
+  double min_span_s = 0.5;
+};
+
 struct AssociatorConfig {
   int window_frames = 10;             // k: observations of the last k frames are kept
   int init_observations = 3;          // g: observations needed to fit and be "initialized"
@@ -36,6 +49,8 @@ struct AssociatorConfig {
   // Per class: score threshold, gate (eq. 6, theta), hits to confirm, misses to end. Detections
   // of a type no policy names are not tracked (counted in FrameAssociations).
   std::vector<ClassPolicy> classes = defaultClassPolicies();
+  // By class name (ClassPolicy::name); a class without an entry is always plausible.
+  std::map<std::string, ClassPlausibility> plausibility;
 
   void validate() const;  // std::invalid_argument naming the bad field
 };
@@ -51,6 +66,10 @@ struct Trajectory {
   bool is_dynamic = false;
   int policy = -1;  // index into AssociatorConfig::classes: the class group it is gated with
   TrackLifecycle lifecycle{0.0, ClassPolicy{}};
+  // Set once the track moved faster than its class allows (ClassPlausibility): the type it is
+  // reported as from then on; "" with `suppressed` when its rows are not reported at all.
+  std::string relabelled_as;
+  bool suppressed = false;
 };
 
 // The outcome for one detection of the frame.
@@ -67,6 +86,9 @@ struct Association {
   double displacement = 0.0;
   TrackStatus status = TrackStatus::Tentative;  // of the trajectory after this detection
   double confidence = 0.0;    // [0, 1], the trajectory's confidence after this detection
+  // Its class's plausibility (ClassPlausibility): re-labelled (box types carry the new type) or
+  // suppressed (the track is not to be reported).
+  bool relabelled = false, suppressed = false;
 };
 
 // A confirmed trajectory the detector missed at this frame, reported at its prediction
@@ -87,9 +109,17 @@ struct SkippedDetections {
   int total() const { return untracked_type + below_score + duplicate; }
 };
 
+// Tracks whose class the window's evidence overrules, by reason (ClassPlausibility), counted once
+// a track, when it is decided.
+struct ClassDecisions {
+  int relabelled_too_fast = 0;
+  int suppressed_too_fast = 0;
+};
+
 struct FrameAssociations {
   std::vector<Association> associations;  // one per tracked detection, in detection order
   SkippedDetections skipped;              // the detections without an association
+  ClassDecisions class_decisions;         // tracks re-labelled or suppressed at this frame
   std::vector<CoastingTrack> coasting;    // confirmed trajectories reported through a miss
   int num_active_tracks = 0;              // trajectories alive after this frame
   int num_ended_tracks = 0;               // trajectories that ended at this frame

@@ -76,6 +76,13 @@ Metrics evaluate(RunData run, const EvalOptions& options) {
     m.velocity_frame = assignVelocities(run, options.dynamic_speed_mps);
     m.tracking = trackingMetrics(run.tracking, options.distance);
     m.tracking_iou = trackingMetrics(run.tracking, options.iou);
+    for (const auto& [cls, name] : {std::pair{"car", "Car"}, {"pedestrian", "Pedestrian"}, {"cyclist", "Cyclist"}}) {
+      std::vector<TrackingFrame> frames = run.tracking;
+      restrictClasses(frames, {name});
+      if (std::none_of(frames.begin(), frames.end(), [](const TrackingFrame& f) { return !f.truth.empty(); })) continue;
+      dropIgnoredTracks(frames, options.distance);
+      m.tracking_by_class[cls] = evaluateClearMot(frames, options.distance);
+    }
   }
   if (run.kitti) m.kitti = evaluateKittiTracking({*run.kitti}, options.kitti);
   m.timing_ms = std::move(run.timing_ms);

@@ -55,6 +55,10 @@ struct Metrics {
   std::string primary_source;                               // "slot", else "odometry", else the first
   std::map<std::string, std::optional<EgoMetrics>> ego;     // per source; null without ground truth
   std::optional<TrackingMetrics> tracking, tracking_iou;    // null without labels or without tracks
+  // The first line's matching per class (car, pedestrian, cyclist: those with labels), every label
+  // all around the sensor: the table that scores a simulated scene whose people stand beside the
+  // road, where the KITTI protocol sees only the few in the camera's image.
+  std::map<std::string, ClearMot> tracking_by_class;
   std::map<std::string, KittiClassMetrics> kitti;           // the KITTI protocol per class; empty without it
   std::string velocity_frame;                               // how velocities were compared
   std::map<std::string, TimingStats> timing_ms;

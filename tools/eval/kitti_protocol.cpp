@@ -54,12 +54,14 @@ struct Track {
   bool ignorable = false;  // ignored when unmatched: neighbour class, small, or in a DontCare region
 };
 struct FramePairs {
+  int frame = 0;
   std::vector<Label> labels;
   std::vector<Track> tracks;
   std::vector<Box> label_boxes, track_boxes;  // upright(), for HOTA
   Eigen::MatrixXd iou;                        // labels x tracks
 };
 struct SequenceFrames {
+  std::string name;
   std::vector<FramePairs> frames;
   // Per track: its rows in the sequence and its score, the mean of its rows' scores. AB3DMOT's
   // script overwrites every row's score with that mean at each pass and averages again at the next,
@@ -138,9 +140,11 @@ SequenceFrames prepare(const KittiSequence& s, const std::string& cls, const Kit
   }
   for (size_t k = 0; k < score_sum.size(); ++k) out.score.push_back(score_sum[k] / out.rows[k]);
 
+  out.name = s.name;
   out.frames.resize(frames.size());
   for (size_t k = 0; k < frames.size(); ++k) {
     FramePairs& f = out.frames[k];
+    f.frame = frames[k];
     for (const kitti::LabelRow* r : labels[k]) {
       // The devkit reads truncation as int(float(...)).
       const int truncation = static_cast<int>(r->truncated);
@@ -167,11 +171,14 @@ SequenceFrames prepare(const KittiSequence& s, const std::string& cls, const Kit
 struct LabelRun {
   std::vector<int> ids;
   std::vector<bool> ignored;
+  std::vector<int> frames;  // the frame of each entry
 };
 
 // IDSW and FRAG of one label as the devkit counts them (its loop over gt trajectories, verbatim in
 // behaviour: `last` forgets the id over ignored frames, a switch needs the previous frame matched).
-void countSwitches(const LabelRun& run, int& idsw, int& frag) {
+// Each switch is appended to `switches` when given.
+void countSwitches(const LabelRun& run, int& idsw, int& frag, const std::string& sequence, int label_id,
+                   std::vector<IdSwitch>* switches) {
   const std::vector<int>& g = run.ids;
   const std::vector<bool>& ign = run.ignored;
   const size_t n = g.size();
@@ -183,7 +190,10 @@ void countSwitches(const LabelRun& run, int& idsw, int& frag) {
       last = -1;
       continue;
     }
-    if (last != g[f] && last != -1 && g[f] != -1 && g[f - 1] != -1) ++idsw;
+    if (last != g[f] && last != -1 && g[f] != -1 && g[f - 1] != -1) {
+      ++idsw;
+      if (switches) switches->push_back({sequence, run.frames[f], label_id, last, g[f]});
+    }
     if (f + 1 < n && g[f - 1] != g[f] && last != -1 && g[f] != -1 && g[f + 1] != -1) ++frag;
     if (g[f] != -1) last = g[f];
   }
@@ -198,7 +208,7 @@ struct PassResult {
 // One evaluation of every sequence with the tracks whose score is >= threshold. When `hota` is
 // given, the frames left after the ignore rules are appended to it (ids made unique per sequence).
 PassResult runPass(const std::vector<SequenceFrames>& sequences, double threshold, const KittiProtocolOptions& o,
-                   const std::string& cls, std::vector<TrackingFrame>* hota) {
+                   const std::string& cls, std::vector<TrackingFrame>* hota, std::vector<IdSwitch>* switches = nullptr) {
   PassResult out;
   KittiCounts& c = out.counts;
   double iou_sum = 0;
@@ -226,6 +236,7 @@ PassResult runPass(const std::vector<SequenceFrames>& sequences, double threshol
         LabelRun& run = runs[l.id];
         run.ids.push_back(col[i] >= 0 ? f.tracks[active[col[i]]].id : -1);
         run.ignored.push_back(l.ignored);
+        run.frames.push_back(f.frame);
         if (col[i] >= 0) {
           label_of[col[i]] = i;
           ++c.tp;
@@ -262,7 +273,7 @@ PassResult runPass(const std::vector<SequenceFrames>& sequences, double threshol
         hota->push_back(std::move(hf));
       }
     }
-    for (const auto& [id, run] : runs) countSwitches(run, c.idsw, c.frag);
+    for (const auto& [id, run] : runs) countSwitches(run, c.idsw, c.frag, sequences[s].name, id, switches);
   }
   if (c.labels > 0) c.mota = 1.0 - static_cast<double>(c.fn + c.fp + c.idsw) / c.labels;
   if (c.tp > 0) c.motp = iou_sum / c.tp;
@@ -346,6 +357,8 @@ std::map<std::string, KittiClassMetrics> evaluateKittiTracking(const std::vector
                                              : std::vector<std::pair<double, double>>();
     m.sweep = sweep(prepared, thresholds, all.counts, options, cls, false);
     m.sweep_ab3dmot = sweep(prepared, thresholds, all.counts, options, cls, true);
+    runPass(prepared, m.sweep.best_threshold.value_or(-std::numeric_limits<double>::infinity()), options, cls, nullptr,
+            &m.best_switches);
     out[cls] = std::move(m);
   }
   return out;

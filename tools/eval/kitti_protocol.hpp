@@ -76,6 +76,12 @@ struct KittiSweep {
   std::optional<double> best_threshold;  // null: all tracks
 };
 
+// One identity switch: a label matched to track `from` in its previous frame and to `to` at `frame`.
+struct IdSwitch {
+  std::string sequence;
+  int frame = 0, label_id = -1, from = -1, to = -1;
+};
+
 struct KittiClassMetrics {
   double min_iou = 0.25;  // the match gate these were computed with
   KittiCounts all;        // every track, no score threshold
@@ -86,6 +92,7 @@ struct KittiClassMetrics {
   // PointRCNN logits this can zero half of them: sequence 0002, pedestrian, 0.18 instead of 0.69).
   KittiSweep sweep_ab3dmot;
   std::optional<Hota> hota;
+  std::vector<IdSwitch> best_switches;  // the identity switches at sweep.best_threshold (all tracks when none)
 };
 
 // Per class name, the metrics over all sequences together. Throws std::invalid_argument naming the

@@ -134,6 +134,7 @@ class LogReader {
     } else if (c == ch_.detections) {
       const auto m = decode<detections_t>(ev, index);
       if (!m) return;
+      addTimings(run_, "detector", m->timings);  // the player's files carry none
       run_.frames.insert(m->frame);
     } else if (c == ch_.status) {
       const auto m = decode<process_status_t>(ev, index);

@@ -13,6 +13,7 @@
 // frame accounting: it only watches).
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -84,6 +85,25 @@ int runToEnd(run::Supervisor& sup, const std::string& name, const std::vector<st
   return sup.stop(name);
 }
 
+// The 1-minute load average (-1 when unknown): a wall-clock rate means little without it.
+double loadAverage() {
+  std::ifstream in("/proc/loadavg");
+  double load = -1;
+  in >> load;
+  return in ? load : -1;
+}
+
+// OUT/speed.yaml: what `./dlslot bench` compares with bench/baseline.yaml (dlslot-bench-check).
+void writeSpeed(const std::string& path, const std::vector<std::pair<std::string, double>>& cpu_ms, double rate,
+                double load_before, double load_after) {
+  std::ofstream f(path);
+  f << "# dlslot-run: CPU time per played frame of each process (ms), the pipeline rate (frames/s)\n"
+    << "# and the 1-minute load average at the start and the end of the play.\n";
+  f << "rate_fps: " << rate << "\nload: [" << load_before << ", " << load_after << "]\ncpu_ms_per_frame:\n";
+  for (const auto& [p, ms] : cpu_ms) f << "  " << p << ": " << ms << "\n";
+  if (!f) throw std::runtime_error("cannot write " + path);
+}
+
 struct Failure : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
@@ -107,7 +127,7 @@ int runPipeline(int argc, char** argv) {
   std::string root, sequence = "0000", scenario, mode = "slot", config = "config/dlslot.yaml", out, lcm_url, detector;
   std::vector<std::string> detections;
   constexpr int kNotGiven = std::numeric_limits<int>::min();
-  int frames = kNotGiven, seed = 1;
+  int frames = kNotGiven, seed = 1, in_flight = 2;
   double speed = std::numeric_limits<double>::quiet_NaN(), stall_s = 60, start_timeout_s = 30, heartbeat_s = 10;
   bool no_eval = false, no_render = false, quiet = false, allow_loss = false, insecure = false;
   std::string key_file, make_key;
@@ -129,6 +149,9 @@ int runPipeline(int argc, char** argv) {
   cl.option("--stall-timeout", &stall_s, "seconds without progress before the run fails (default 60)");
   cl.option("--heartbeat-timeout", &heartbeat_s,
             "seconds without a process's PROCESS_STATUS before it counts as stalled and the run fails (default 10)");
+  cl.option("--in-flight", &in_flight,
+            "lockstep: frames the player keeps ahead of SLOT_STATE (default 2: the odometry of t+1 overlaps the "
+            "backend's t, same results; 1: strict lockstep)");
   cl.flag("--allow-loss", &allow_loss, "exit 0 even when frames were lost (they are still reported)");
   cl.flag("--no-eval", &no_eval, "skip the evaluation");
   cl.flag("--no-render", &no_render, "do not start the renderer");
@@ -169,6 +192,7 @@ int runPipeline(int argc, char** argv) {
     throw std::invalid_argument("--heartbeat-timeout: expected >= 2 s (processes report once a second), got " +
                                 std::to_string(heartbeat_s));
   if (out.empty()) throw std::invalid_argument("--out DIR is required");
+  if (in_flight < 1) throw std::invalid_argument("--in-flight: expected an integer >= 1");
   config = fs::absolute(findConfigFile(config)).string();  // the children get the same file from any directory
   if (root.empty() == scenario.empty()) throw std::invalid_argument("give either --kitti ROOT or --scenario NAME");
   const ModeSettings ms = settingsFor(mode);
@@ -286,7 +310,14 @@ int runPipeline(int argc, char** argv) {
     sup.start("renderer", args(bin + "/dlslot-renderer", render_args), logs + "/renderer.log");
   }
   sup.start("backend", args(bin + "/dlslot-backend", {"--mode", ms.backend}), logs + "/backend.log");
-  sup.start("tracker", args(bin + "/dlslot-tracker", {}), logs + "/tracker.log");
+  // Lockstep with two frames in flight: the player publishes frame t+1 once SLOT_STATE carried
+  // t-1, so the odometry of t+1 runs while the tracker and the backend finish t, and the tracker
+  // waits for SLOT_STATE t before associating t+1 (slot_state_gate.hpp): every process sees its
+  // inputs in frame order and the tracker the optimized poses of strict lockstep, so the results
+  // are the same bytes (pipeline_overlap test). --in-flight 1: strict lockstep.
+  sup.start("tracker", args(bin + "/dlslot-tracker", speed > 0 ? std::vector<std::string>{}
+                                                                  : std::vector<std::string>{"--follow-slot-state"}),
+            logs + "/tracker.log");
   sup.start("odometry", args(bin + "/dlslot-odometry", {"--mode", ms.odometry}), logs + "/odometry.log");
   if (geometric) {
     pipeline.push_back("detector");
@@ -366,9 +397,10 @@ int runPipeline(int argc, char** argv) {
   if (speed > 0)
     play.insert(play.end(), {"--speed", std::to_string(speed)});
   else
-    play.insert(play.end(), {"--lockstep", "SLOT_STATE"});
+    play.insert(play.end(), {"--lockstep", "SLOT_STATE", "--in-flight", std::to_string(in_flight)});
   sup.start("player", args(bin + "/dlslot-player", play), logs + "/player.log");
   const auto play_start = Node::Clock::now();
+  const double load_before = loadAverage();
   ProgressLine progress("run " + (scenario.empty() ? sequence : scenario) + " [" + mode + "]", last_frame + 1);
   last_progress = Node::Clock::now();
   auto healthText = [&] {
@@ -444,22 +476,29 @@ int runPipeline(int argc, char** argv) {
   node.spinUntil([] { return false; }, 0.3);
   sup.stop("lcm-logger");
   // Where the two cores went: each process's CPU time over the whole run, per played frame.
+  std::vector<std::pair<std::string, double>> cpu_ms;
   {
     std::string line;
-    for (const std::string p : {"odometry", "tracker", "backend", "renderer", "foxglove", "player", "lcm-logger"}) {
-      if ((p == std::string("renderer") && no_render) || (p == std::string("foxglove") && !foxglove)) continue;
+    for (const std::string p : {"odometry", "detector", "tracker", "backend", "renderer", "foxglove", "player",
+                                "lcm-logger"}) {
+      if ((p == std::string("renderer") && no_render) || (p == std::string("foxglove") && !foxglove) ||
+          (p == std::string("detector") && !geometric))
+        continue;
       const double s = sup.cpuSeconds(p);
       if (s < 0) continue;
+      cpu_ms.emplace_back(p, 1e3 * s / (last_frame + 1));
       char buf[96];
-      std::snprintf(buf, sizeof buf, "%s%s %.1f ms", line.empty() ? "" : ", ", p.c_str(), 1e3 * s / (last_frame + 1));
+      std::snprintf(buf, sizeof buf, "%s%s %.1f ms", line.empty() ? "" : ", ", p.c_str(), cpu_ms.back().second);
       line += buf;
     }
     std::fprintf(stderr, "CPU per frame: %s\n", line.c_str());
   }
   // The pipeline rate: from the player's start (less its start-up delay) to the last SLOT_STATE.
   const double play_s = std::chrono::duration<double>(last_slot_time - play_start).count() - 0.2;
+  const double rate = play_s > 0 ? slot_frames / play_s : 0.0;
   std::fprintf(stderr, "SLOT_STATE for %d of %d frames; pipeline rate %.2f frames/s (%s)\n", slot_frames,
-               last_frame + 1, play_s > 0 ? slot_frames / play_s : 0.0, speed > 0 ? "rate mode" : "lockstep");
+               last_frame + 1, rate, speed > 0 ? "rate mode" : "lockstep");
+  writeSpeed(out + "/speed.yaml", cpu_ms, rate, load_before, loadAverage());
   if (slot_frames != last_frame + 1) std::cerr << "warning: frames are missing from SLOT_STATE\n";
   // Where every frame went, and the memory of each process over the run.
   const FrameAccounting accounting = accountFrames(health, last_frame + 1, accounted);
@@ -488,8 +527,11 @@ int runPipeline(int argc, char** argv) {
     if (runToEnd(sup, "eval", eval, logs + "/eval.log") != 0) throw Failure("dlslot-eval failed:\n" + sup.tail("eval", 30));
     std::cout << run::readText(logs + "/eval.log");
   }
-  std::cout << "outputs in " << out << ": run.lcmlog, trajectory_*.txt, tracks_kitti.txt, metrics.json, report.md, "
+  std::cout << "outputs in " << out << ": run.lcmlog, speed.yaml, trajectory_*.txt, tracks_kitti.txt, metrics.json, report.md, "
             << (no_render ? "" : "bev/, ") << "plots/, config.yaml, logs/\n";
+  std::cout << "to look at it: report.md has every table; " << (no_render ? "" : "bev/ one bird's-eye image a frame "
+            "(points, boxes coloured by track with id and speed, the trajectories; any image viewer), ")
+            << "plots/ the trajectories and their errors\n";
   std::cout << std::flush;
   std::cerr << "dlslot-run: " << accounting.verdict() << "\n";
   if (accounting.hasLoss() && !allow_loss) return 4;

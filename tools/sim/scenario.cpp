@@ -344,6 +344,15 @@ Scenario loadScenario(const std::string& path) {
 
 std::string resolveScenario(const std::string& name_or_path, const std::string& source_dir) {
   if (fs::is_regular_file(name_or_path)) return name_or_path;
+  // An installed dlslot-sim finds the scenarios installed beside it (PREFIX/share/dlslot), a
+  // built one those of its source tree.
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path installed =
+        exe.parent_path().parent_path() / "share" / "dlslot" / "config" / "scenarios" / (name_or_path + ".yaml");
+    if (fs::is_regular_file(installed, ec)) return installed.string();
+  }
   const fs::path named = fs::path(source_dir) / "config" / "scenarios" / (name_or_path + ".yaml");
   if (fs::is_regular_file(named)) return named.string();
   std::vector<std::string> names;

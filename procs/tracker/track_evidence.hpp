@@ -1,0 +1,53 @@
+// The score column of the results files: one number per track, ranking tracks by the evidence
+// that they are real objects, on the detector's own scale (a raw logit for PointRCNN).
+//
+// Score-swept metrics (sAMOTA, AMOTA; AB3DMOT's evaluate.py and dlslot-eval alike) give every track
+// the mean of its rows' scores and drop whole tracks below a threshold, so what matters is how the
+// tracks rank. A track's evidence is the mean detection score over its life (first to last
+// detection), in which every frame it was not detected counts as a detection at the class's floor
+// (the weakest score a detection may have and still be tracked: a real object the detector missed
+// reads as no better than that), shrunk towards that floor by `min_hits` pseudo-frames (a track of
+// one or two detections has not yet shown it is more than the detector's noise: the lifecycle's
+// own confirmation count is the measure of how much evidence is "enough").
+//
+// The value is written on every row of the track and rounded to a binary grid (multiples of
+// 2^-20), so that a mean of n equal rows is that value exactly in floating point: the script
+// averages its rows' scores anew at every pass of its sweep, and any other value drifts by
+// rounding from pass to pass until the track at a threshold falls below it.
+#pragma once
+
+#include <map>
+#include <set>
+#include <vector>
+
+#include "dlslot/kitti.hpp"
+#include "dlslot/track_lifecycle.hpp"
+
+namespace dlslot::tracker {
+
+// What a track showed over its life.
+struct TrackEvidence {
+  double score_sum = 0.0;  // raw detection scores of its detections
+  int hits = 0;            // detections
+  int first_frame = -1, last_frame = -1;
+  void add(int frame, double score);
+  int missed() const { return hits > 0 ? last_frame - first_frame + 1 - hits : 0; }
+};
+
+// The floor a missed frame counts as: the class's min_score_to_extend when it has one, else 0
+// (even odds on the logit scale, the probability 0.5).
+double evidenceFloor(const ClassPolicy& policy);
+
+// The track's score (see above), before rounding.
+double trackScore(const TrackEvidence& e, const ClassPolicy& policy);
+
+// `v` on the binary grid of 2^-20 (a mean of equal values on it is exact for up to 2^27 rows
+// while |v| < 64), moved up by grid steps until no other track of `taken` has it.
+double distinctGridScore(double v, std::set<double>& taken);
+
+// Sets the score of every row to its track's evidence. `evidence` by track id; rows of a track id
+// it does not hold keep their score.
+void writeTrackScores(std::vector<kitti::LabelRow>& rows, const std::map<int, TrackEvidence>& evidence,
+                      const std::map<int, const ClassPolicy*>& policy_of);
+
+}  // namespace dlslot::tracker

@@ -59,14 +59,15 @@ void ConfigSection::get(const std::string& key, T& out) {
       if (!n.IsSequence()) throw YAML::Exception(n.Mark(), "");
     }
     out = n.as<T>();
-    // .nan and .inf are numbers to YAML but never a setting: refused like a misspelt key.
-    bool finite = true;
-    if constexpr (std::is_same_v<T, double>) finite = std::isfinite(out);
+    // .nan is a number to YAML but never a setting: refused like a misspelt key.
+    // (.inf is a limit that is not there, e.g. a speed bound a class does not have.)
+    bool number = true;
+    if constexpr (std::is_same_v<T, double>) number = !std::isnan(out);
     if constexpr (std::is_same_v<T, std::vector<double>>)
-      for (double v : out) finite = finite && std::isfinite(v);
-    if (!finite)
+      for (double v : out) number = number && !std::isnan(v);
+    if (!number)
       throw ConfigError(where(key) + " (line " + std::to_string(n.Mark().line + 1) +
-                        "): expected a finite number, got " + (n.IsScalar() ? "'" + n.Scalar() + "'" : "a list with one that is not"));
+                        "): expected a number, got " + (n.IsScalar() ? "'" + n.Scalar() + "'" : "a list with .nan in it"));
   } catch (const YAML::Exception&) {
     std::string got = n.IsScalar() ? "'" + n.Scalar() + "'" : n.IsSequence() ? "a list" : "a map";
     throw ConfigError(where(key) + " (line " + std::to_string(n.Mark().line + 1) + "): expected " +

@@ -99,6 +99,17 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   s.get("gradient_tolerance", c.gradient_tolerance);
   s.get("parameter_tolerance", c.parameter_tolerance);
   s.get("compute_covariance", c.compute_covariance);
+  s.get("registration_types", c.registration_types);
+  s.get("registration_min_points", c.registration.min_points);
+  require(c.registration.min_points >= 6, s, "registration_min_points", "an integer >= 6");
+  s.get("registration_information_scale", c.registration.information_scale);
+  require(c.registration.information_scale > 0.0, s, "registration_information_scale", "a number > 0");
+  s.get("registration_max_sigma", c.registration.max_sigma);
+  require(c.registration.max_sigma > 0.0, s, "registration_max_sigma", "a distance > 0 (m)");
+  s.get("registration_box_margin", c.registration_box_margin);
+  require(c.registration_box_margin >= 0.0, s, "registration_box_margin", "a distance >= 0 (m)");
+  s.get("registration_ground_clearance", c.registration_ground_clearance);
+  require(c.registration_ground_clearance >= 0.0, s, "registration_ground_clearance", "a distance >= 0 (m)");
   s.get("solver_threads", c.solver_threads);
   require(c.solver_threads >= 1, s, "solver_threads", "an integer >= 1");
   return c;

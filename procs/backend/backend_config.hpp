@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "backend/object_registration.hpp"
 #include "backend/se3.hpp"
 #include "dlslot/config.hpp"
 
@@ -51,6 +52,17 @@ struct BackendConfig {
   // instead of odometry_sigma when it is valid.
   bool use_odometry_covariance = true;
   Eigen::Vector2d odometry_covariance_scale = Eigen::Vector2d(5.0, 5.0);  // translation, rotation
+
+  // Per-object registration (object_registration.hpp): the classes whose own points, registered
+  // from scan to scan, measure their pose changes (eq. 10's c) beside the boxes; empty: none, the
+  // box chain alone, the default). Pedestrians belong outside it: a walker 20 m away has a few
+  // dozen points on a body that changes shape as it walks.
+  std::vector<std::string> registration_types;
+  RegistrationOptions registration;
+  // The points taken for an object (the node's selection): its box grown by this margin (m) on
+  // every side but the bottom, which is raised this far above the box's floor (the ground).
+  double registration_box_margin = 0.2;
+  double registration_ground_clearance = 0.3;
 
   // Robust loss on (landmark) observations, the factors that see outliers: none|huber|cauchy,
   // scale in whitened units (1 = one sigma).

@@ -6,7 +6,10 @@
 #include <string>
 #include <vector>
 
+#include "backend/object_registration.hpp"
 #include "backend/se3.hpp"
+#include <array>
+#include <memory>
 #include "dlslot/track_lifecycle.hpp"
 #include "dlslot/types.hpp"
 
@@ -27,6 +30,9 @@ struct ObservationInput {
   bool dynamic_guess = false; // the tracker's preliminary static/dynamic guess
   bool confirmed = true;      // the tracker's lifecycle confirmed the track (tentative ones stay out of the graph)
   double confidence = 1.0;    // the track's confidence after this detection, [0, 1]
+  // The object's points in this scan (lidar frame; the node's selection by its box), when the
+  // scan arrived: per-object registration (object_registration.hpp).
+  std::shared_ptr<const ObjectPoints> points;
 };
 
 struct BackendInput {
@@ -78,6 +84,14 @@ struct BackendOutput {
   std::vector<TrackEstimate> tracks;
   SolveStats stats;
   int static_to_dynamic = 0;  // landmarks that turned dynamic this frame
+  // Per-object registrations this frame by outcome (RegistrationOutcome), and objects of a
+  // registered class whose previous scan's points were missing (new, or missed last frame).
+  std::array<int, kNumRegistrationOutcomes> registrations{};
+  int registration_no_previous = 0;
+  // Over this frame's registrations: the objects' points (previous scan) and the squared RMS
+  // point-to-plane residual, summed (to compare the simulator's objects with real ones).
+  int64_t registration_points = 0;
+  double registration_residual_sq = 0;
 };
 
 }  // namespace dlslot::backend

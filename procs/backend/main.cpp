@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -11,6 +12,9 @@
 
 #include "backend/backend_messages.hpp"
 #include "backend/heap_memory.hpp"
+#include "backend/object_points.hpp"
+#include "dlslot/convert.hpp"
+#include "dlslot/point_cloud_t.hpp"
 #include "dlslot/frame_joiner.hpp"
 #include "dlslot/kitti.hpp"
 #include "dlslot/lcm_log.hpp"
@@ -87,6 +91,10 @@ void report(ProcessStatus& status, const BackendOutput& out) {
   if (out.odometry_missing) status.count("odometry_missing");
   if (out.associations_missing) status.count("associations_missing");
   if (out.static_to_dynamic) status.count("static_to_dynamic", out.static_to_dynamic);
+  for (int k = 0; k < kNumRegistrationOutcomes; ++k)
+    if (out.registrations[k])
+      status.count(std::string("registration_") + toString(static_cast<RegistrationOutcome>(k)), out.registrations[k]);
+  if (out.registration_no_previous) status.count("registration_no_previous", out.registration_no_previous);
 }
 
 // Offline: every ODOMETRY and ASSOCIATIONS event of a log, joined by frame, in frame order.
@@ -110,16 +118,30 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
     else accepted[index] = msg->frame;
     return !why;
   };
+  // The newest scan (per-object registration): a frame's scan comes before its associations.
+  const bool use_scans = !config.registration_types.empty() && config.mode != Mode::kOdometryOnly;
+  std::optional<std::pair<int, PointCloud>> scan;
+  std::map<std::string, FrameOrder> scan_order;
   LogEnvelopes envelopes(in_path);  // every event verified as it would be live (lcm_log.hpp)
   for (; const lcm::LogEvent* raw = nextLogEvent(in, in_path); ++index) {
     const lcm::LogEvent* ev = envelopes.open(*raw, guard, in_path + ": event " + std::to_string(index) + ": ");
     if (!ev) continue;
-    if (ev->channel == channels.odometry) {
+    if (use_scans && ev->channel == channels.scan) {
+      point_cloud_t m;
+      Refusal why = decodeChecked(ev->data, static_cast<size_t>(std::max(ev->datalen, 0)), &m);
+      if (!why) why = scan_order[ev->channel].accept(m.frame);
+      if (why) guard.refused(ev->channel, why, in_path + ": event " + std::to_string(index) + ": ");
+      else scan.emplace(m.frame, dlslot::fromMsg(m));
+    } else if (ev->channel == channels.odometry) {
       odometry_t m;
       if (decode(*ev, &m)) joiner.addA(m.frame, OdometryPart{m.utime, fromMsg(m)}, 0.0);
     } else if (ev->channel == channels.associations) {
       associations_t m;
-      if (decode(*ev, &m)) joiner.addB(m.frame, AssociationsPart{m.utime, observationsFromMsg(m, &rejected)}, 0.0);
+      if (decode(*ev, &m)) {
+        AssociationsPart part{m.utime, observationsFromMsg(m, &rejected)};
+        if (scan && scan->first == m.frame) attachObjectPoints(scan->second, config, part.observations);
+        joiner.addB(m.frame, std::move(part), 0.0);
+      }
     }
   }
   int64_t refused = 0;
@@ -128,6 +150,9 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   TimingStats total, solve, marginalize;
   int frames = 0, missing_odometry = 0, missing_associations = 0;
   int64_t landmarks = 0, moving = 0, switched = 0;  // summed over frames
+  std::array<int64_t, kNumRegistrationOutcomes> registrations{};
+  int64_t registration_no_previous = 0, registration_points = 0;
+  double registration_residual_sq = 0;
   std::map<int, slot_state_t> states;
   std::map<int, int> inputs_left;  // frame -> its input events not yet copied to the output
   for (const Joiner::Joined& j : joiner.flush()) {
@@ -142,6 +167,10 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
     marginalize.add(result.stats.marginalize_ms);
     for (const TrackEstimate& e : result.tracks) (e.dynamic ? moving : landmarks) += 1;
     switched += result.static_to_dynamic;
+    for (int k = 0; k < kNumRegistrationOutcomes; ++k) registrations[k] += result.registrations[k];
+    registration_no_previous += result.registration_no_previous;
+    registration_points += result.registration_points;
+    registration_residual_sq += result.registration_residual_sq;
     states[j.frame] = toMsg(result, toString(config.mode));
     inputs_left[j.frame] = (j.a ? 1 : 0) + (j.b ? 1 : 0);
   }
@@ -196,6 +225,16 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   std::printf("  objects in the graph per frame: %.1f static landmarks, %.1f moving; %lld landmarks turned dynamic\n",
               frames ? double(landmarks) / frames : 0.0, frames ? double(moving) / frames : 0.0,
               static_cast<long long>(switched));
+  std::printf("  per-object registrations:");
+  for (int k = 0; k < kNumRegistrationOutcomes; ++k)
+    std::printf(" %s %lld", toString(static_cast<RegistrationOutcome>(k)), static_cast<long long>(registrations[k]));
+  std::printf(", no previous scan %lld\n", static_cast<long long>(registration_no_previous));
+  int64_t attempts = 0;
+  for (int k = 0; k < kNumRegistrationOutcomes; ++k) attempts += registrations[k];
+  const int64_t ok = registrations[0] + registrations[1];
+  if (attempts > 0)
+    std::printf("  points per registered object %.0f; point-to-plane RMS of the measured ones %.4f m\n",
+                double(registration_points) / attempts, ok ? std::sqrt(registration_residual_sq / ok) : 0.0);
   return 0;
 }
 
@@ -223,9 +262,18 @@ int runLive(const BackendConfig& config, const Channels& channels, const NodeOpt
       node.status().warn("ODOMETRY of frame " + std::to_string(m.frame) + " arrived after the frame was solved");
     handleReady();
   });
+  // The scans (per-object registration): the newest few, a frame's scan arrives before its
+  // associations. Not subscribed when no class registers (nothing changes then).
+  std::map<int, PointCloud> scans;
+  if (!config.registration_types.empty() && config.mode != Mode::kOdometryOnly)
+    node.subscribeFrames<point_cloud_t>(channels.scan, [&](const point_cloud_t& m) {
+      scans[m.frame] = dlslot::fromMsg(m);
+      while (scans.size() > 3) scans.erase(scans.begin());
+    });
   node.subscribeFrames<associations_t>(channels.associations, [&](const associations_t& m) {
     int rejected = 0;
     AssociationsPart part{m.utime, observationsFromMsg(m, &rejected)};
+    if (const auto s = scans.find(m.frame); s != scans.end()) attachObjectPoints(s->second, config, part.observations);
     if (rejected) node.status().error(std::to_string(rejected) + " malformed boxes in ASSOCIATIONS of frame " + std::to_string(m.frame));
     if (!joiner.addB(m.frame, std::move(part), nowSeconds()))
       node.status().warn("ASSOCIATIONS of frame " + std::to_string(m.frame) + " arrived after the frame was solved");

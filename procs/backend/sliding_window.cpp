@@ -13,6 +13,7 @@
 #include "backend/observation_factor.hpp"
 #include "backend/odometry_factor.hpp"
 #include "backend/pose_change_factor.hpp"
+#include "backend/registration_factor.hpp"
 #include "backend/vehicle_motion_factor.hpp"
 
 namespace dlslot::backend {
@@ -66,7 +67,7 @@ BackendOutput SlidingWindow::process(const BackendInput& in) {
 
   addEgoFrame(in);
   if (config_.mode != Mode::kOdometryOnly) {
-    addObservations(in);
+    addObservations(in, out);
     out.static_to_dynamic = switchMovingLandmarks();
   }
   solve(out);
@@ -133,7 +134,7 @@ void SlidingWindow::addEgoFrame(const BackendInput& in) {
 
 // ---- step 2: observations, eq. 9-11 with eq. 12's membership ----
 
-void SlidingWindow::addObservations(const BackendInput& in) {
+void SlidingWindow::addObservations(const BackendInput& in, BackendOutput& out) {
   const Pose X = fromBlock(frames_.back().pose->data());
   for (const ObservationInput& obs : in.observations) {
     if (obs.track_id < 0) continue;
@@ -151,12 +152,52 @@ void SlidingWindow::addObservations(const BackendInput& in) {
     track.dynamic_guess = obs.dynamic_guess;
     track.confidence = obs.confidence;
     track.observations[in.frame] = Observation{alignedBox(track, X, obs.box), false};
+    registerPoints(track, obs, in.frame, X, out);
     // Not in O_init yet, or not confirmed by the tracker's lifecycle (a likely false positive):
     // evidence only, never in the graph where it could pull the ego poses.
     if (!obs.initialized || !obs.confirmed) continue;
     if (track.model == TrackModel::kNotInGraph) startTrack(track, in.frame);
     addTrackObservation(track, in.frame);
   }
+}
+
+bool SlidingWindow::registers(const std::string& type) const {
+  return std::find(config_.registration_types.begin(), config_.registration_types.end(), type) !=
+         config_.registration_types.end();
+}
+
+void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, int frame, const Pose& X, BackendOutput& out) {
+  if (!obs.points || !registers(track.type)) return;
+  auto world = std::make_shared<ObjectPoints>();
+  world->reserve(obs.points->size());
+  for (const Eigen::Vector3f& p : *obs.points) world->push_back((X * p.cast<double>()).cast<float>());
+  const std::shared_ptr<const ObjectPoints> previous = track.points;
+  const int previous_frame = track.points_frame;
+  track.points = world;
+  track.points_frame = frame;
+  if (!previous || previous_frame != frame - 1) {
+    ++out.registration_no_previous;
+    return;
+  }
+  // The prediction: the chain's latest pose change carried to the world at o_{t-1}, else the
+  // displacement of the box centres (a box is good to a few decimetres: inside the
+  // registration's reach).
+  Pose M0 = Pose::Identity();
+  const auto o_prev = track.poses.find(frame - 1);
+  const auto prev_obs = track.observations.find(frame - 1);
+  const EgoFrame* prev_ego = findFrame(frame - 1);
+  if (track.model == TrackModel::kDynamic && o_prev != track.poses.end() && !track.changes.empty()) {
+    const Pose o = fromBlock(o_prev->second->data());
+    M0 = o * fromBlock(track.changes.rbegin()->second->data()) * o.inverse();
+  } else if (prev_obs != track.observations.end() && prev_ego) {
+    M0.translation() = (X * track.observations.at(frame).b).translation() -
+                       (fromBlock(prev_ego->pose->data()) * prev_obs->second.b).translation();
+  }
+  const RegistrationResult r = registerObject(*previous, *world, M0, obs.box.center.norm(), config_.registration);
+  ++out.registrations[static_cast<int>(r.outcome)];
+  out.registration_points += r.source_points;
+  if (r.ok()) out.registration_residual_sq += r.rms_residual * r.rms_residual;
+  if (r.ok()) track.motions[frame] = Track::Motion{r.motion, r.information};
 }
 
 std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track) const {
@@ -242,6 +283,12 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
     double* change = newBlock(track.changes[f - 1], fromBlock(prev).inverse() * o_f);  // eq. 2
     addFactor(PoseChangeFactor::Create(sqrtInformation(config_.pose_change_sigma)), false, {prev, cur, change});
     if (isVehicle(track.type)) addFactor(VehicleMotionFactor::Create(config_.vehicle_motion_sigma), false, {change});
+    // The object's points measured this pose change (robust: a wrong association registers two
+    // objects' points).
+    if (const auto m = track.motions.find(f); m != track.motions.end()) {
+      const PoseChangeMeasurement pm = poseChangeMeasurement(m->second.M, m->second.information, fromBlock(prev));
+      addFactor(PoseChangeMeasurementFactor::Create(pm.c_meas, pm.sqrt_info), true, {change});
+    }
     auto before = track.changes.find(f - 2);
     if (before != track.changes.end())
       addFactor(ConstantVelocityFactor::Create(sqrtInformation(config_.constant_velocity_sigma)), false,
@@ -454,6 +501,7 @@ SmoothedPose SlidingWindow::slide() {
     track.poses.erase(track.poses.begin(), track.poses.upper_bound(s));
     track.changes.erase(track.changes.begin(), track.changes.upper_bound(s));
     track.observations.erase(track.observations.begin(), track.observations.upper_bound(s));
+    track.motions.erase(track.motions.begin(), track.motions.upper_bound(s));
   }
   for (Track* track : left_view) {
     track->model = TrackModel::kNotInGraph;

@@ -74,12 +74,24 @@ class SlidingWindow {
     // chain to estimate it again (coasting, or about to leave).
     std::optional<Eigen::Vector3d> velocity;
     bool velocity_from_chain = false;
+    // Per-object registration: the object's points of its latest scan (world frame), and the
+    // motions measured between consecutive scans (frame t -> M of t-1 -> t, world frame).
+    std::shared_ptr<const ObjectPoints> points;
+    int points_frame = -1;
+    struct Motion {
+      Pose M = Pose::Identity();
+      Matrix6 information = Matrix6::Zero();
+    };
+    std::map<int, Motion> motions;
     Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
   };
 
   void addEgoFrame(const BackendInput& in);
-  void addObservations(const BackendInput& in);
+  void addObservations(const BackendInput& in, BackendOutput& out);
   void startTrack(Track& track, int frame);
+  // Registers the object's points of this frame to those of the previous one (when it has both).
+  void registerPoints(Track& track, const ObservationInput& obs, int frame, const Pose& X, BackendOutput& out);
+  bool registers(const std::string& type) const;
   // The velocity of the line through the track's boxes in the window (windowMotion), for a
   // vehicle turned toward the mean heading of its boxes (velocityAlongHeading): a young
   // vehicle's, and a pedestrian's at every age.

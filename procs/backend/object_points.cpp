@@ -1,0 +1,36 @@
+#include "backend/object_points.hpp"
+
+#include <algorithm>
+
+#include "dlslot/box_filter.hpp"
+
+namespace dlslot::backend {
+
+void attachObjectPoints(const PointCloud& scan, const BackendConfig& config, std::vector<ObservationInput>& observations) {
+  std::vector<Box> volumes;
+  std::vector<int> owner;
+  for (size_t i = 0; i < observations.size(); ++i) {
+    const ObservationInput& o = observations[i];
+    if (std::find(config.registration_types.begin(), config.registration_types.end(), o.box.type) ==
+        config.registration_types.end())
+      continue;
+    const Box v = removalVolume(o.box, config.registration_box_margin, config.registration_ground_clearance);
+    if (v.size.z() <= 0.0) continue;
+    volumes.push_back(v);
+    owner.push_back(static_cast<int>(i));
+  }
+  if (volumes.empty()) return;
+  // The grid-accelerated mask first (most points are in no box), then each object point's boxes.
+  const std::vector<bool> inside = pointsInBoxes(scan, volumes, 0.0);
+  std::vector<std::shared_ptr<ObjectPoints>> points(volumes.size());
+  for (auto& p : points) p = std::make_shared<ObjectPoints>();
+  for (Eigen::Index i = 0; i < scan.cols(); ++i) {
+    if (!inside[i]) continue;
+    const Eigen::Vector3d p = scan.col(i).head<3>().cast<double>();
+    for (size_t b = 0; b < volumes.size(); ++b)
+      if (volumes[b].contains(p)) points[b]->push_back(p.cast<float>());
+  }
+  for (size_t b = 0; b < volumes.size(); ++b) observations[owner[b]].points = std::move(points[b]);
+}
+
+}  // namespace dlslot::backend

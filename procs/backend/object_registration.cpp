@@ -1,0 +1,311 @@
+#include "backend/object_registration.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+namespace dlslot::backend {
+namespace {
+
+// The current points binned in a dense voxel grid (point indices per voxel). A query's nearest
+// point is searched in its voxel's 3x3x3 neighbourhood; each target point's plane (its nearest
+// neighbours there, one 3x3 eigen-decomposition) is fitted on first use and cached.
+class PlaneGrid {
+ public:
+  struct Plane {
+    bool valid = false;
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  };
+
+  PlaneGrid(const std::vector<Eigen::Vector3d>& points, double voxel, int pad, const RegistrationOptions& o)
+      : points_(points), options_(o) {
+    Eigen::Vector3d lo = points.front(), hi = points.front();
+    for (const Eigen::Vector3d& p : points) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    // A long truck at a small voxel: grow the voxel until the grid stays small.
+    for (;;) {
+      origin_ = lo - Eigen::Vector3d::Constant(pad * voxel);
+      for (int k = 0; k < 3; ++k) dims_[k] = static_cast<int>(std::floor((hi[k] - lo[k]) / voxel)) + 1 + 2 * pad;
+      if (static_cast<long>(dims_[0]) * dims_[1] * dims_[2] <= 200'000) break;
+      voxel *= 1.5;
+    }
+    voxel_ = voxel;
+    const size_t n = static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2];
+    start_.assign(n + 1, 0);
+    std::vector<long> cell(points.size());
+    for (size_t i = 0; i < points.size(); ++i) {
+      cell[i] = index(points[i]);
+      ++start_[cell[i] + 1];
+    }
+    for (size_t k = 1; k < start_.size(); ++k) start_[k] += start_[k - 1];
+    members_.resize(points.size());
+    std::vector<int> next(start_.begin(), start_.end() - 1);
+    for (size_t i = 0; i < points.size(); ++i) members_[next[cell[i]]++] = static_cast<int>(i);
+    planes_.resize(points.size());
+    fitted_.assign(points.size(), 0);
+  }
+
+  // The nearest point to q within one voxel's reach (-1: none), and its squared distance.
+  int nearest(const Eigen::Vector3d& q, double* d2) const {
+    int best = -1;
+    double best_d2 = 1e300;
+    forNeighbourhood(q, [&](int j) {
+      const double d = (points_[j] - q).squaredNorm();
+      if (d < best_d2) {
+        best_d2 = d;
+        best = j;
+      }
+    });
+    *d2 = best_d2;
+    return best;
+  }
+
+  const Plane& plane(int j) {
+    if (!fitted_[j]) fit(j);
+    return planes_[j];
+  }
+
+ private:
+  long index(const Eigen::Vector3d& p) const {
+    int c[3];
+    if (!cellOf(p, c)) return -1;
+    return (static_cast<long>(c[2]) * dims_[1] + c[1]) * dims_[0] + c[0];
+  }
+  bool cellOf(const Eigen::Vector3d& p, int* c) const {
+    for (int k = 0; k < 3; ++k) {
+      const double f = (p[k] - origin_[k]) / voxel_;
+      if (!(f >= 0) || f >= dims_[k]) return false;
+      c[k] = static_cast<int>(f);
+    }
+    return true;
+  }
+  template <typename F>
+  void forNeighbourhood(const Eigen::Vector3d& q, F&& each) const {
+    int c[3];
+    if (!cellOf(q, c)) return;
+    for (int z = std::max(0, c[2] - 1); z <= std::min(dims_[2] - 1, c[2] + 1); ++z)
+      for (int y = std::max(0, c[1] - 1); y <= std::min(dims_[1] - 1, c[1] + 1); ++y)
+        for (int x = std::max(0, c[0] - 1); x <= std::min(dims_[0] - 1, c[0] + 1); ++x) {
+          const long k = (static_cast<long>(z) * dims_[1] + y) * dims_[0] + x;
+          for (int m = start_[k]; m < start_[k + 1]; ++m) each(members_[m]);
+        }
+  }
+
+  void fit(int j) {
+    fitted_[j] = 1;
+    const Eigen::Vector3d& p = points_[j];
+    near_.clear();
+    auto& near = near_;
+    forNeighbourhood(p, [&](int m) { near.emplace_back((points_[m] - p).squaredNorm(), m); });
+    const int k = std::min<int>(static_cast<int>(near.size()), options_.plane_neighbours);
+    if (k < options_.min_plane_points) return;
+    std::nth_element(near.begin(), near.begin() + (k - 1), near.end());
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int i = 0; i < k; ++i) mean += points_[near[i].second];
+    mean /= k;
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (int i = 0; i < k; ++i) {
+      const Eigen::Vector3d d = points_[near[i].second] - mean;
+      cov += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+    es.computeDirect(cov / k);
+    const Eigen::Vector3d ev = es.eigenvalues();  // ascending
+    // A plane: one small eigenvalue, two spread ones (a single scan ring is a line: no plane).
+    if (!(ev[1] > 1e-6) || ev[0] > options_.max_planarity * ev[1]) return;
+    planes_[j] = Plane{true, es.eigenvectors().col(0)};
+  }
+
+  const std::vector<Eigen::Vector3d>& points_;
+  const RegistrationOptions& options_;
+  Eigen::Vector3d origin_;
+  int dims_[3];
+  double voxel_;
+  std::vector<int> start_, members_;
+  std::vector<Plane> planes_;
+  std::vector<char> fitted_;
+  std::vector<std::pair<double, int>> near_;
+};
+
+// One point per cell of edge `cell` (the first one met), then every k-th of those if more than
+// `max_points` remain. Cells, not a stride over the scan: a scan lists its points ring by ring,
+// and every k-th point of that order leaves lines, not surfaces.
+std::vector<Eigen::Vector3d> thin(const ObjectPoints& points, const Eigen::Vector3d& shift, double cell, int max_points) {
+  std::vector<Eigen::Vector3d> out;
+  if (points.empty()) return out;
+  Eigen::Vector3d lo = points.front().cast<double>(), hi = lo;
+  for (const Eigen::Vector3f& p : points) {
+    lo = lo.cwiseMin(p.cast<double>());
+    hi = hi.cwiseMax(p.cast<double>());
+  }
+  long dims[3];
+  for (;;) {
+    for (int k = 0; k < 3; ++k) dims[k] = static_cast<long>((hi[k] - lo[k]) / cell) + 1;
+    if (dims[0] * dims[1] * dims[2] <= 400'000) break;
+    cell *= 1.5;
+  }
+  std::vector<char> taken(static_cast<size_t>(dims[0] * dims[1] * dims[2]), 0);
+  out.reserve(points.size());
+  for (const Eigen::Vector3f& p : points) {
+    const Eigen::Vector3d q = p.cast<double>();
+    long c[3];
+    bool inside = true;
+    for (int k = 0; k < 3; ++k) {
+      const double f = (q[k] - lo[k]) / cell;
+      inside &= f >= 0 && f < dims[k];
+      c[k] = inside ? static_cast<long>(f) : 0;
+    }
+    if (!inside) continue;
+    char& t = taken[static_cast<size_t>((c[2] * dims[1] + c[1]) * dims[0] + c[0])];
+    if (t) continue;
+    t = 1;
+    out.push_back(q - shift);
+  }
+  if (static_cast<int>(out.size()) > max_points) {
+    const double step = static_cast<double>(out.size()) / max_points;
+    std::vector<Eigen::Vector3d> kept;
+    kept.reserve(max_points);
+    for (int i = 0; i < max_points; ++i) kept.push_back(out[static_cast<size_t>(i * step)]);
+    out.swap(kept);
+  }
+  return out;
+}
+
+}  // namespace
+
+const char* toString(RegistrationOutcome outcome) {
+  switch (outcome) {
+    case RegistrationOutcome::kMeasured: return "measured";
+    case RegistrationOutcome::kPartial: return "partial";
+    case RegistrationOutcome::kTooFewPoints: return "too_few_points";
+    case RegistrationOutcome::kDegenerate: return "degenerate";
+    case RegistrationOutcome::kPoorFit: return "poor_fit";
+    case RegistrationOutcome::kDiverged: return "diverged";
+  }
+  return "?";
+}
+
+RegistrationResult registerObject(const ObjectPoints& previous, const ObjectPoints& current, const Pose& prediction,
+                                  double range, const RegistrationOptions& o) {
+  RegistrationResult result;
+  result.source_points = static_cast<int>(previous.size());
+  result.target_points = static_cast<int>(current.size());
+  result.motion = prediction;
+  if (static_cast<int>(previous.size()) < o.min_points || static_cast<int>(current.size()) < o.min_points) {
+    result.outcome = RegistrationOutcome::kTooFewPoints;
+    return result;
+  }
+  // Centred on the current points' centroid: rotations turn about the object, so translation and
+  // rotation separate in the Hessian (about the world origin 30 m away they would not).
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3f& p : current) c += p.cast<double>();
+  c /= static_cast<double>(current.size());
+  // A near car has thousands of points: both sides are thinned to one point per half voxel (and a
+  // bounded number), which bounds the work per object.
+  const double voxel = std::max(o.min_voxel, o.voxel_per_m * range);
+  const std::vector<Eigen::Vector3d> target = thin(current, c, 0.5 * voxel, o.max_target_points);
+  const std::vector<Eigen::Vector3d> source = thin(previous, c, 0.5 * voxel, o.max_source_points);
+  PlaneGrid grid(target, voxel, 2, o);
+
+  // M_c = T(-c) M T(c): q = R p + t in centred coordinates.
+  Eigen::Matrix3d R = prediction.linear();
+  Eigen::Vector3d t = prediction.linear() * c + prediction.translation() - c;
+  const Eigen::Matrix3d R0 = R;
+  const Eigen::Vector3d t0 = t;
+  Matrix6 H = Matrix6::Zero();
+  double sigma2 = o.point_sigma * o.point_sigma;
+  int inliers = 0;
+  double wr2 = 0, wsum = 0;
+  for (int it = 0; it < o.max_iterations; ++it) {
+    H.setZero();
+    Vector6 g = Vector6::Zero();
+    inliers = 0;
+    wr2 = wsum = 0;
+    for (const Eigen::Vector3d& p : source) {
+      const Eigen::Vector3d Rp = R * p;
+      const Eigen::Vector3d q = Rp + t;
+      double d2;
+      const int j = grid.nearest(q, &d2);
+      if (j < 0 || d2 > o.max_residual * o.max_residual) continue;
+      const PlaneGrid::Plane& plane = grid.plane(j);
+      if (!plane.valid) continue;
+      const double r = plane.normal.dot(q - target[j]);
+      ++inliers;
+      const double u = r / o.cauchy_scale, w = 1.0 / (1.0 + u * u);
+      Vector6 J;
+      J << plane.normal, Rp.cross(plane.normal);
+      H.selfadjointView<Eigen::Lower>().rankUpdate(J, w);
+      g += w * r * J;
+      wr2 += w * r * r;
+      wsum += w;
+    }
+    result.iterations = it + 1;
+    if (inliers < 6) break;
+    H.triangularView<Eigen::Upper>() = H.transpose();
+    // A light damping keeps unmeasured directions where the prediction put them.
+    Matrix6 A = H;
+    A.diagonal().array() += 1e-6 * H.diagonal().maxCoeff() + 1e-9;
+    Vector6 d = -A.ldlt().solve(g);
+    // A step is at most max_step (m, and rad x 2 m): a direction the points hardly constrain must
+    // not throw the estimate off in one step.
+    const double len = std::max(d.head<3>().norm(), 2.0 * d.tail<3>().norm());
+    if (len > o.max_step) d *= o.max_step / len;
+    t += d.head<3>();
+    R = expSO3(d.tail<3>()).toRotationMatrix() * R;
+    if (d.head<3>().norm() + 2.0 * d.tail<3>().norm() < o.converged_step) break;
+  }
+  result.inliers = inliers;
+  // Back to the world: M p = R (p - c) + t + c.
+  result.motion.linear() = R;
+  result.motion.translation() = t + c - R * c;
+  if (inliers < std::max(6.0, o.min_inlier_fraction * static_cast<double>(source.size()))) {
+    result.outcome = RegistrationOutcome::kPoorFit;
+    return result;
+  }
+  result.rms_residual = std::sqrt(wr2 / std::max(wsum, 1e-12));
+  // The centroid of the previous points moved this far from where the prediction put it.
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : source) s += p;
+  s /= static_cast<double>(source.size());
+  if (((R * s + t) - (R0 * s + t0)).norm() > o.max_correction) {
+    result.outcome = RegistrationOutcome::kDiverged;
+    return result;
+  }
+  // The residuals' variance (robust-weighted, with the 6 fitted dimensions taken off), floored by
+  // the sensor's noise.
+  const double dof = std::max(1.0, wsum * (1.0 - 6.0 / std::max(7.0, static_cast<double>(inliers))));
+  sigma2 = std::max(sigma2, wr2 / dof);
+  Matrix6 info = H * (o.information_scale / sigma2);
+  // Horizontal translation directions the points do not constrain: the marginal covariance of
+  // (tx, ty), rotations and height included, has a standard deviation above max_sigma there (a
+  // flat side seen edge-on: the motion along it). Their information is removed, not guessed.
+  Matrix6 reg = info;
+  reg.diagonal().array() += 1e-9 * std::max(1.0, info.diagonal().maxCoeff());
+  const Matrix6 cov = reg.ldlt().solve(Matrix6::Identity());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(cov.topLeftCorner<2, 2>());
+  int horizontal_dropped = 0;
+  Matrix6 P = Matrix6::Identity();
+  for (int k = 0; k < 2; ++k) {
+    if (es.eigenvalues()[k] <= o.max_sigma * o.max_sigma) continue;
+    ++horizontal_dropped;
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    v.head<2>() = es.eigenvectors().col(k);
+    P.topLeftCorner<3, 3>() -= v * v.transpose();
+  }
+  if (horizontal_dropped >= 2) {
+    result.outcome = RegistrationOutcome::kDegenerate;
+    return result;
+  }
+  info = P.transpose() * info * P;
+  // Centred tangent -> world tangent at M: dt_c = dt_w - [R c]x dtheta_w, dtheta_c = dtheta_w.
+  Matrix6 G = Matrix6::Identity();
+  G.block<3, 3>(0, 3) = -skew(R * c);
+  result.information = G.transpose() * info * G;
+  result.outcome = horizontal_dropped ? RegistrationOutcome::kPartial : RegistrationOutcome::kMeasured;
+  return result;
+}
+
+}  // namespace dlslot::backend

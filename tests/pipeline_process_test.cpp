@@ -93,7 +93,7 @@ TEST(PipelineProcess, EveryFrameOnEveryChannelAndMetricsWithinBounds) {
   const auto status = decodeAll<process_status_t>(events["PROCESS_STATUS"]);
   std::map<std::string, process_status_t> last;
   for (const auto& s : status) last[s.name] = s;
-  for (const std::string p : {"player", "odometry", "tracker", "backend", "renderer"}) {
+  for (const std::string p : {"player", "odometry", "tracker", "backend", "renderer", "mapper"}) {
     ASSERT_TRUE(last.count(p)) << p;
 #ifdef __SANITIZE_ADDRESS__
     // ./dlslot test --sanitize: several times slower, so inputs may miss their time limits.
@@ -105,12 +105,19 @@ TEST(PipelineProcess, EveryFrameOnEveryChannelAndMetricsWithinBounds) {
   // Outputs and metrics.
   for (const std::string f : {"metrics.json", "report.md", "trajectory_slot_kitti.txt", "trajectory_odometry_kitti.txt",
                               "trajectory_groundtruth_kitti.txt", "trajectory_slot_tum.txt", "tracks_kitti.txt",
-                              "config.yaml", "bev/000000.png"})
+                              "config.yaml", "bev/000000.png", "map.pcd", "map_removed.pcd", "map.png",
+                              "trajectory_map_kitti.txt", "trajectory_map_tum.txt", "trajectory_map_kitti_cam.txt"})
     EXPECT_TRUE(fs::exists(out + "/" + f)) << f;
   const YAML::Node m = YAML::LoadFile(out + "/metrics.json");
   EXPECT_LT(m["ego.ate_rmse_m"].as<double>(), 1.0);
   EXPECT_GT(m["tracking.mota"].as<double>(), 0.3);
   EXPECT_EQ(m["frames.SLOT_STATE"].as<int>(), kFrames);
+  // The mapper: a MAP_STATE per scan, a static map that keeps the scene and drops the traffic.
+  EXPECT_EQ(events["MAP_STATE"].size(), static_cast<size_t>(kFrames));
+  EXPECT_GT(m["map.sa"].as<double>(), 0.9);
+  EXPECT_GT(m["map.da"].as<double>(), 0.5);
+  EXPECT_EQ(m["map.loops_false"].as<int>(), 0);
+  EXPECT_LT(m["sources.map.ate_rmse_m"].as<double>(), 1.0);
 }
 
 TEST(PipelineProcess, SameRunTwiceGivesIdenticalSlotState) {

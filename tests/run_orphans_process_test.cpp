@@ -38,8 +38,8 @@ TEST(RunOrphansProcess, SigkillOfTheLauncherLeavesNoChildRunning) {
   std::this_thread::sleep_for(std::chrono::seconds(2));
   ASSERT_TRUE(run.running()) << run.output();
   const std::set<pid_t> children = childrenOf(run.pid());
-  // lcm-logger, renderer, backend, tracker, odometry and the player.
-  ASSERT_EQ(children.size(), 6u) << run.output();
+  // lcm-logger, renderer, mapper, backend, tracker, odometry and the player.
+  ASSERT_EQ(children.size(), 7u) << run.output();
 
   kill(run.pid(), SIGKILL);
   EXPECT_EQ(run.wait(10), 128 + SIGKILL);

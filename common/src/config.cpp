@@ -170,7 +170,7 @@ void Channels::read(ConfigSection s) {
 
 ConfigSection loadPipelineConfig(const std::string& file, Channels& channels) {
   ConfigSection root = loadConfig(file);
-  for (const char* section : {"channels", "player", "detector", "odometry", "tracker", "backend", "renderer"}) root.skip(section);
+  for (const char* section : {"channels", "player", "detector", "odometry", "tracker", "backend", "renderer", "mapper"}) root.skip(section);
   root.finish();
   channels.read(root.section("channels"));
   return root;

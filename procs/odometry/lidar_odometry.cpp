@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include "dlslot/box_filter.hpp"
 #include "dlslot/cpu_clock.hpp"
+#include "degeneracy.hpp"
 #include "fallback_motion.hpp"
 #include "rigid_motion.hpp"
 #include "scan_to_map.hpp"
@@ -35,6 +37,16 @@ Matrix6d solveCovariance(const Matrix6d& normal_matrix, const OdometryConfig& cf
   return info.inverse();
 }
 
+// Covariance of a registration's translation (rotation marginalised), the prediction's
+// information added as in solveCovariance.
+Eigen::Matrix3d translationCovariance(const TranslationConstraint& c, const OdometryConfig& cfg) {
+  const double s2 = cfg.residual_sigma_m * cfg.residual_sigma_m;
+  const double prior = 1.0 / (cfg.fallback_sigma_m * cfg.fallback_sigma_m);
+  Eigen::Vector3d var;
+  for (int i = 0; i < 3; ++i) var(i) = 1.0 / (c.information(i) / s2 + prior);
+  return c.directions * var.asDiagonal() * c.directions.transpose();
+}
+
 }  // namespace
 
 LidarOdometry::LidarOdometry(OdometryConfig cfg)
@@ -49,6 +61,7 @@ void LidarOdometry::reset() {
   fallbacks_ = 0;
   registered_velocity_ = Pose::Identity();
   last_index_ = 0;
+  frames_since_check_ = 0;
 }
 
 void LidarOdometry::fallBack(Status status, const std::string& why, const Pose& prediction, OdometryResult& out) {
@@ -111,7 +124,9 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
   // Scan-to-scan from the prediction (the previous scan's edges and planes); false when it fails.
   double s2s_index = 0.0, s2s_match = 0.0, s2s_solve = 0.0, s2m_match = 0.0, s2m_solve = 0.0;
   Pose s2s_pose = prediction;
-  auto scanToScan = [&]() -> bool {
+  Registration s2s_last;  // the last scan-to-scan registration of this frame
+  // fall_back: a failure publishes the prediction (false: only reported, the caller goes on).
+  auto scanToScan = [&](bool fall_back = true) -> bool {
     const auto t_s2s = Clock::now();
     const double cpu_index = threadCpuMs();
     reference_.index();
@@ -131,7 +146,9 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
       if (kept.solution.ok && (!s2s.solution.ok || kept.solution.num_inliers > s2s.solution.num_inliers)) s2s = kept;
     }
     s2s_ms += msSince(t_s2s);
+    s2s_last = s2s;
     if (!s2s.solution.ok) {
+      if (!fall_back) return false;
       fallBack(Status::FallbackSolveFailed,
                "scan-to-scan failed (" + std::to_string(s2s.num_correspondences) + " correspondences)", prediction,
                out);
@@ -165,6 +182,7 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
   out.detail.emplace_back("s2m_downsample", threadCpuMs() - cpu);
   out.num_map_edge = static_cast<int>(map_.edges().size());
   out.num_map_plane = static_cast<int>(map_.planes().size());
+  bool reanchored = false;  // a weak direction's check disagreed: scan-to-scan's pose wins
   // Why a map registration is not taken ("" when it is).
   // After fallbacks the prediction is a guess: a solution far from it is taken when scan-to-map
   // agrees with scan-to-scan (re-anchoring); otherwise one bad solution is kept out.
@@ -175,7 +193,8 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
     const Pose correction = prediction.inverse() * s2m.solution.T_ref_cur;
     if (!s2m.solution.ok)
       return "scan-to-map failed (" + std::to_string(s2m.num_correspondences) + " correspondences)";
-    const bool anchored = fallbacks_ > 0 && !beyond(s2s_pose.inverse() * s2m.solution.T_ref_cur);
+    const bool anchored =
+        (fallbacks_ > 0 || reanchored) && !beyond(s2s_pose.inverse() * s2m.solution.T_ref_cur);
     if (moving_ && beyond(correction) && !anchored)
       return "solution jumped " + std::to_string(correction.translation().norm()) + " m from the prediction";
     return "";
@@ -200,15 +219,65 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
         return finish();
       }
       s2m = scanToMap(s2s_pose);
+    } else if (!scan_to_scan_first && moving_) {
+      // The map registration started from the constant-velocity prediction. Along a direction
+      // it hardly constrains (a highway: the position along the road) its solution is that
+      // prediction, and a map built with a wrong velocity agrees with it (every scan was put in
+      // where the wrong velocity said): a wrong velocity would be kept for ever. Scan-to-scan
+      // depends on neither the map nor the velocity's history, and its wider search reaches
+      // farther from a poor prediction. It checks the map registration where a direction is weak
+      // (degeneracy.hpp), and every check_every_frames frames whatever the constraint (a bound on
+      // how long a wrong velocity lasts, at a fraction of a scan-to-scan per frame). Where the
+      // two disagree beyond both covariances (chi-square, 1 degree of freedom) and by more than
+      // the map registration's own search can pull back, scan-to-scan's motion is taken and the
+      // map, built with the wrong velocity, is started over.
+      const TranslationConstraint map_c = translationConstraint(s2m.solution.normal_matrix);
+      const bool weak = map_c.ratio() < cfg_.weak_direction_ratio;
+      const bool audit = cfg_.check_every_frames > 0 && frames_since_check_ + 1 >= cfg_.check_every_frames;
+      if (weak || audit) {
+        frames_since_check_ = -1;  // counted up to 0 below
+        if (weak) {
+          out.weak_direction = map_c.weakest();
+          out.degeneracy = Degeneracy::Unchecked;
+        }
+        s2m_ms += msSince(t);
+        const bool ok = scanToScan(false);
+        t = Clock::now();
+        if (ok) {
+          const TranslationConstraint s2s_c = translationConstraint(s2s_last.solution.normal_matrix);
+          const Pose& map_pose = s2m.solution.T_ref_cur;
+          const Eigen::Vector3d d = map_pose.linear().transpose() * (s2s_pose.translation() - map_pose.translation());
+          // The weak direction, or on an audit the direction of the disagreement itself.
+          const Eigen::Vector3d v = weak || d.norm() < 1e-9 ? map_c.weakest() : Eigen::Vector3d(d.normalized());
+          // Scan-to-scan as weak along v (the same missing structure) cannot tell.
+          const double s2s_info =
+              v.dot(s2s_c.directions * s2s_c.information.asDiagonal() * s2s_c.directions.transpose() * v);
+          if (s2s_info >= cfg_.weak_direction_ratio * s2s_c.information(2)) {
+            out.check_disagreement_m = v.dot(d);
+            out.check_chi2 = chiSquareAlong(d, v, translationCovariance(map_c, cfg_), translationCovariance(s2s_c, cfg_));
+            if (weak) out.degeneracy = Degeneracy::Confirmed;
+            if (out.check_chi2 > cfg_.check_chi2 &&
+                std::abs(out.check_disagreement_m) > cfg_.check_min_disagreement_m) {
+              reanchored = true;
+              out.weak_direction = v;
+              out.degeneracy = Degeneracy::Reanchored;
+            }
+          }
+        }
+      }
     }
-    const std::string failure = failureOf(s2m);
+    const std::string failure = reanchored ? "" : failureOf(s2m);
     if (!failure.empty()) {
       s2m_ms += msSince(t);
       addDetail();
       fallBack(Status::FallbackSolveFailed, failure, prediction, out);
       return finish();
     }
-    pose = s2m.solution.T_ref_cur;
+    // Re-anchored: this scan's motion is scan-to-scan's, the map starts over from this scan.
+    const Registration& used = reanchored ? s2s_last : s2m;
+    pose = reanchored ? s2s_pose : s2m.solution.T_ref_cur;
+    if (reanchored) map_.clear();
+    ++frames_since_check_;
     out.status = Status::Ok;
     if (fallbacks_ > 0) {  // registered again: said once, for the logs
       const Pose correction = prediction.inverse() * pose;
@@ -216,10 +285,29 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
                         std::to_string(fallbacks_) + " fallback frames, " +
                         std::to_string(correction.translation().norm()) + " m from the prediction";
     }
-    out.min_eigenvalue = s2m.solution.min_eigenvalue;
-    out.residual_mean = s2m.solution.residual_mean;
-    out.num_correspondences = s2m.num_correspondences;
-    out.covariance = solveCovariance(s2m.solution.normal_matrix, cfg_);
+    {
+      const TranslationConstraint c = translationConstraint(used.solution.normal_matrix);
+      out.translation_information = c.information;
+      if (out.degeneracy == Degeneracy::None) out.weak_direction = c.weakest();
+      if (out.degeneracy != Degeneracy::None) {
+        char buf[200];
+        const Eigen::Vector3d& v = out.weak_direction;
+        std::snprintf(buf, sizeof buf,
+                      "weakly constrained along (%.2f, %.2f, %.2f) (information ratio %.1e): %s", v.x(), v.y(), v.z(),
+                      c.ratio(),
+                      out.degeneracy == Degeneracy::Unchecked ? "scan-to-scan could not check it"
+                      : out.degeneracy == Degeneracy::Confirmed ? "scan-to-scan agrees"
+                                                                : "scan-to-scan disagreed, velocity re-anchored, map restarted");
+        std::string text = buf;
+        if (out.degeneracy == Degeneracy::Reanchored)
+          text += " (" + std::to_string(out.check_disagreement_m) + " m, chi-square " + std::to_string(out.check_chi2) + ")";
+        out.status_text += (out.status_text.empty() ? "" : "; ") + text;
+      }
+    }
+    out.min_eigenvalue = used.solution.min_eigenvalue;
+    out.residual_mean = used.solution.residual_mean;
+    out.num_correspondences = used.num_correspondences;
+    out.covariance = solveCovariance(used.solution.normal_matrix, cfg_);
   } else {
     out.status = Status::FirstFrame;
     out.covariance = Matrix6d::Zero();

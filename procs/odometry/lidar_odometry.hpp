@@ -18,6 +18,15 @@ enum class Status {
   FirstFrame,           // identity pose, nothing to register against
 };
 
+// How the map registration constrained the translation (degeneracy.hpp), and what was done.
+enum class Degeneracy {
+  None,          // every direction constrained (or nothing registered)
+  Confirmed,     // a weak direction, and scan-to-scan agreed with the map registration along it
+  Reanchored,    // scan-to-scan disagreed (along a weak direction, or on a periodic check): the
+                 // motion is scan-to-scan's, the map starts over
+  Unchecked,     // a weak direction, and scan-to-scan could not check it (failed or as weak)
+};
+
 struct OdometryResult {
   int frame = 0;
   Status status = Status::Ok;
@@ -27,6 +36,13 @@ struct OdometryResult {
   Pose delta = Pose::Identity();   // T_prev_cur
   Matrix6d covariance = Matrix6d::Identity();  // of delta, tangent (t, rotation), m and rad
   double min_eigenvalue = 0.0;     // of the scan-to-map normal matrix
+  // The translation's information per direction (ascending) and the weakest direction (lidar
+  // frame) of the map registration, and whether that direction was weak and checked.
+  Eigen::Vector3d translation_information = Eigen::Vector3d::Zero();
+  Eigen::Vector3d weak_direction = Eigen::Vector3d::Zero();
+  Degeneracy degeneracy = Degeneracy::None;
+  double check_disagreement_m = 0.0;  // scan-to-scan minus scan-to-map along weak_direction
+  double check_chi2 = 0.0;            // ...its chi-square (1 dof) against both covariances
   int num_points_in = 0;
   int num_points_removed = 0;
   int num_edge = 0, num_plane = 0;            // sharp and flat features
@@ -70,6 +86,7 @@ class LidarOdometry {
   int fallbacks_ = 0;                          // consecutive fallback frames (fallback_motion.hpp)
   Pose registered_velocity_ = Pose::Identity();  // velocity_ at the last registration (never decayed)
   int last_index_ = 0;                         // frame index of the last scan
+  int frames_since_check_ = 0;                 // map registrations since scan-to-scan last checked one
 };
 
 }  // namespace dlslot::odometry

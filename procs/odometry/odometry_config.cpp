@@ -103,6 +103,14 @@ OdometryConfig readOdometryConfig(ConfigSection& s) {
   s.get("residual_sigma_m", c.residual_sigma_m);
   s.get("fallback_sigma_m", c.fallback_sigma_m);
   s.get("fallback_sigma_deg", c.fallback_sigma_deg);
+  s.get("weak_direction_ratio", c.weak_direction_ratio);
+  s.get("check_chi2", c.check_chi2);
+  s.get("check_every_frames", c.check_every_frames);
+  s.get("check_min_disagreement_m", c.check_min_disagreement_m);
+  if (c.check_every_frames < 0 || !(c.check_min_disagreement_m >= 0.0))
+    throw ConfigError(s.file() + ": " + s.path() + ": expected check_every_frames >= 0 and check_min_disagreement_m >= 0");
+  if (!(c.weak_direction_ratio >= 0.0 && c.weak_direction_ratio < 1.0) || !(c.check_chi2 > 0.0))
+    throw ConfigError(s.file() + ": " + s.path() + ": expected 0 <= weak_direction_ratio < 1 and check_chi2 > 0");
   readFeatures(s.section("features"), c.features);
   readScanToScan(s.section("scan_to_scan"), c.scan_to_scan);
   readScanToMap(s.section("scan_to_map"), c.scan_to_map);

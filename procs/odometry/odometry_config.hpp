@@ -98,6 +98,23 @@ struct OdometryConfig {
   double residual_sigma_m = 0.05;
   double fallback_sigma_m = 1.0;
   double fallback_sigma_deg = 5.0;
+  // A map registration from the prediction is weak along a direction whose translation
+  // information is below this fraction of the strongest direction's (degeneracy.hpp): its
+  // standard deviation 1/sqrt(ratio) times the best one's. That direction is then checked by
+  // scan-to-scan, and a disagreement with chi-square above check_chi2 (1 degree of freedom;
+  // 6.63: 1 % of agreeing estimates would be taken for disagreeing) re-anchors the pose and the
+  // velocity to scan-to-scan's.
+  double weak_direction_ratio = 0.01;
+  double check_chi2 = 6.63;
+  // Scan-to-scan also checks every this many-th map registration (0: only weak ones): a wrong
+  // velocity that the map itself has come to agree with would last at most this many frames.
+  // Off by default: on the constructed corridor scan-to-scan from the wrong prediction agreed
+  // with the wrong map registration (docs/ego.md), so it is not yet shown to help.
+  int check_every_frames = 0;
+  // ...and a disagreement is acted on only beyond this (m): closer, the map registration's own
+  // correspondences (searched within scan_to_map.max_neighbor_distance_m, 1 m) reach the right
+  // surfaces and pull it back by itself. Half that radius.
+  double check_min_disagreement_m = 0.5;
 };
 
 // Parses a mode name: "aloam" (no removal) or "aloam-filtered" (A-LOAM*); throws

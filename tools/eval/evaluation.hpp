@@ -14,9 +14,21 @@
 #include "ego_metrics.hpp"
 #include "hota.hpp"
 #include "kitti_protocol.hpp"
+#include "map_quality.hpp"
 #include "tracking_frames.hpp"
 
 namespace dlslot::eval {
+
+// dlslot-eval --map: the mapper's static map and loops.
+struct MapMetrics {
+  MapScore score;                  // null SA/DA when the scans or labels are not there
+  int loops_accepted = 0;
+  std::optional<int> loops_false;  // null without ground-truth poses
+  int keyframes = 0;
+  int64_t map_points = 0;
+  // |t| of (first^-1 last) minus the truth's, for the map trajectory and for SLOT's.
+  std::optional<double> end_to_start_m, slot_end_to_start_m;
+};
 
 struct RunData {
   std::map<std::string, Trajectory> sources;  // the system's ego trajectories, by source name
@@ -34,6 +46,7 @@ struct RunData {
   std::vector<std::string> notes;                // facts for the report (process health, warnings)
   std::optional<FrameAccounting> frames;         // where every played frame went (a recorded run)
   std::map<std::string, RssSummary> memory;      // process -> resident memory over the run
+  std::optional<MapMetrics> map;                 // --map
 };
 
 struct EvalOptions {
@@ -66,6 +79,7 @@ struct Metrics {
   std::vector<std::string> notes;
   std::optional<FrameAccounting> frames;
   std::map<std::string, RssSummary> memory;
+  std::optional<MapMetrics> map;
 };
 
 std::string primarySource(const std::map<std::string, Trajectory>& sources);

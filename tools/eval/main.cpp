@@ -7,6 +7,13 @@
 #include <set>
 #include <sstream>
 
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
 #include "dlslot/input_error.hpp"
 #include "dlslot/kitti.hpp"
 #include "dlslot/node.hpp"
@@ -29,6 +36,7 @@ struct Options {
   std::string gt_poses, gt_format = "kitti";
   std::string tracks;
   std::string out, export_dir;
+  std::string map_dir;
   std::string classes;
   double match_distance = 2.0, min_iou = 0.25, dynamic_speed = 0.5, frame_period = 0.1;
   double image_width = kitti::ImageSize().width, image_height = kitti::ImageSize().height;
@@ -209,6 +217,127 @@ void addProcessNotes(const RunLog& log, RunData& run) {
   }
 }
 
+// The mapper's keyframes (map_keyframes.txt: frame, kept, removed, T_map_lidar 3x4) or accepted
+// loops (map_loops.txt: query, match, accepted, ..., T_match_query 3x4).
+std::vector<std::vector<double>> readNumberRows(const std::string& path, size_t min_fields) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, 0, "cannot open");
+  std::vector<std::vector<double>> rows;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ls(line);
+    std::vector<double> v;
+    double x;
+    while (v.size() < 18 && ls >> x) v.push_back(x);
+    if (v.size() < min_fields || !std::all_of(v.begin(), v.end(), [](double d) { return std::isfinite(d); }))
+      throw InputError(path, n, "expected at least " + std::to_string(min_fields) + " finite numbers");
+    rows.push_back(std::move(v));
+  }
+  return rows;
+}
+
+Pose poseFrom12(const std::vector<double>& v, size_t at) {
+  Pose T = Pose::Identity();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) T.matrix()(r, c) = v[at + 4 * r + c];
+  T.linear() = Eigen::Quaterniond(T.rotation()).normalized().toRotationMatrix();
+  return T;
+}
+
+// dlslot-eval --map DIR: the mapper's trajectory as source "map", the map's SA / DA / AA against
+// the labels (when the data set has scans and labels), its loops against the true poses.
+void addMap(const Options& o, const DataSet& data, RunData& run) {
+  const fs::path dir(o.map_dir);
+  MapMetrics mm;
+  run.sources["map"] = readTrajectory((dir / "trajectory_map_kitti.txt").string(), TrajectoryFormat::Kitti, std::nullopt,
+                                      o.frame_period);
+  std::map<int, Pose> map_pose, truth_pose;
+  {
+    const Trajectory& t = run.sources["map"];
+    for (size_t i = 0; i < t.size(); ++i) map_pose[t.frames[i]] = t.poses[i];
+  }
+  if (run.truth) {
+    const Trajectory truth = inWorldOf(*run.truth, run.sources["map"]);
+    for (size_t i = 0; i < truth.size(); ++i) truth_pose[truth.frames[i]] = truth.poses[i];
+  }
+  // Loops.
+  int accepted = 0, wrong = 0;
+  for (const auto& r : readNumberRows((dir / "map_loops.txt").string(), 18)) {
+    if (r[2] != 1) continue;
+    ++accepted;
+    const auto q = truth_pose.find(static_cast<int>(r[0])), m = truth_pose.find(static_cast<int>(r[1]));
+    if (q != truth_pose.end() && m != truth_pose.end()) wrong += isFalseLoop(poseFrom12(r, 6), m->second.inverse() * q->second);
+  }
+  mm.loops_accepted = accepted;
+  if (!truth_pose.empty()) mm.loops_false = wrong;
+  // End-to-start: how far the last scan's pose relative to the first is from the truth's (what a
+  // loop that returns to its start must get right).
+  auto endToStart = [&](const Trajectory& t) -> std::optional<double> {
+    if (t.size() < 2 || !truth_pose.count(t.frames.front()) || !truth_pose.count(t.frames.back())) return std::nullopt;
+    const Pose est = t.poses.front().inverse() * t.poses.back();
+    const Pose gt = truth_pose[t.frames.front()].inverse() * truth_pose[t.frames.back()];
+    return (est.translation() - gt.translation()).norm();
+  };
+  mm.end_to_start_m = endToStart(run.sources["map"]);
+  if (run.sources.count("slot")) mm.slot_end_to_start_m = endToStart(run.sources["slot"]);
+  // The map.
+  pcl::PointCloud<pcl::PointXYZI> cloud;
+  const std::string pcd = (dir / "map.pcd").string();
+  if (pcl::io::loadPCDFile(pcd, cloud) != 0) throw InputError(pcd, 0, "not a PCD file PCL can read");
+  PointCloud map_points(4, static_cast<Eigen::Index>(cloud.size()));
+  for (size_t i = 0; i < cloud.size(); ++i) map_points.col(static_cast<Eigen::Index>(i)) << cloud[i].x, cloud[i].y, cloud[i].z, cloud[i].intensity;
+  mm.map_points = static_cast<int64_t>(cloud.size());
+  const auto keyframe_rows = readNumberRows((dir / "map_keyframes.txt").string(), 15);
+  mm.keyframes = static_cast<int>(keyframe_rows.size());
+  MapTruthOptions opt;
+  {
+    ConfigSection root = loadConfig(findConfigFile(o.config));
+    ConfigSection mapper = root.section("mapper");
+    mapper.get("map_voxel_m", opt.voxel_m);
+    mapper.get("min_range_m", opt.min_range_m);
+    mapper.get("max_range_m", opt.max_range_m);
+  }
+  mm.score.voxel_m = opt.voxel_m;
+  if (!o.kitti_root.empty()) {
+    const kitti::SequenceReader reader(o.kitti_root, o.sequence, {}, -1e300, o.frame_period);
+    if (reader.hasScans() && reader.hasLabels()) {
+      if (!reader.paths().poses_are_lidar) {
+        // Real KITTI labels: only what camera 2 sees (its horizontal field of view from P2).
+        const kitti::Calib& calib = reader.calib();
+        opt.T_cam_lidar = calib.T_rect_velo();
+        const double fx = calib.P[2](0, 0);
+        opt.camera_half_fov_rad = fx > 0 ? std::atan(0.5 * kitti::ImageSize().width / fx) : 0.0;
+      }
+      std::vector<MapKeyframe> keyframes;
+      std::map<int, std::vector<Box>> labels;
+      for (int f = 0; f < reader.size(); ++f) labels[f] = reader.read(f).labels;
+      for (const auto& r : keyframe_rows) {
+        MapKeyframe k;
+        k.frame = static_cast<int>(r[0]);
+        if (k.frame < 0 || k.frame >= reader.size()) throw InputError((dir / "map_keyframes.txt").string(), 0, "frame outside the sequence");
+        k.T_map_lidar = poseFrom12(r, 3);
+        const Frame f = reader.read(k.frame);
+        k.scan = f.scan;
+        k.labels = f.labels;
+        keyframes.push_back(std::move(k));
+      }
+      // Which tracks move: in the true world when there is one, else in the map's (the slice's approximate poses are
+      // not read as truth).
+      const std::set<int> moving = movingTracks(labels, truth_pose.empty() ? map_pose : truth_pose, opt.moving_span_m);
+      mm.score = scoreMap(map_points, keyframes, moving, opt);
+      run.notes.push_back("map: " + std::to_string(moving.size()) + " labelled tracks move (centres span > " +
+                          std::to_string(opt.moving_span_m) + " m in the " + (truth_pose.empty() ? "map's" : "true") +
+                          " world); " + (opt.T_cam_lidar ? "scored in camera 2's field of view" : "scored all around"));
+    } else {
+      run.notes.push_back("map: SA / DA not scored: the sequence has no scans or no labels");
+    }
+  } else {
+    run.notes.push_back("map: SA / DA not scored: no --kitti ROOT --sequence S for the scans and labels");
+  }
+  run.map = mm;
+}
+
 int run(int argc, char** argv) {
   Options o;
   CommandLine cl("dlslot-eval",
@@ -227,6 +356,9 @@ int run(int argc, char** argv) {
   cl.option("--tracks", &o.tracks, "tracks in the KITTI tracking result format (needs --kitti for labels and calib)");
   cl.option("--out", &o.out, "write DIR/metrics.json, DIR/report.md, DIR/plots/*.png");
   cl.option("--export", &o.export_dir, "write DIR/trajectory_<source>_<format>.txt and DIR/tracks_kitti.txt");
+  cl.option("--map", &o.map_dir,
+            "the mapper's output directory (map.pcd, map_keyframes.txt, map_loops.txt, trajectory_map_kitti.txt): "
+            "map.sa/da/aa against the labels, loops against the true poses, the map trajectory as source 'map'");
   cl.option("--classes", &o.classes, "evaluated classes, comma-separated (default: all)");
   cl.option("--match-distance", &o.match_distance, "centre-distance gate in metres (default 2)");
   cl.option("--min-iou", &o.min_iou, "3D IoU gate of the second line and of the KITTI protocol (default 0.25)");
@@ -290,6 +422,7 @@ int run(int argc, char** argv) {
   if (!o.gt_poses.empty())
     run.truth = readTrajectory(o.gt_poses, parseTrajectoryFormat(o.gt_format), camFromVelo(data), o.frame_period);
 
+  if (!o.map_dir.empty()) addMap(o, data, run);
   if (!o.traj.empty()) {
     Trajectory t = readTrajectory(o.traj, parseTrajectoryFormat(o.traj_format), camFromVelo(data), o.frame_period);
     if (run.truth) requireSameLength(t, o.traj, *run.truth, o.gt_poses.empty() ? "the data set's poses" : o.gt_poses);

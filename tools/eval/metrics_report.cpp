@@ -276,6 +276,21 @@ std::string metricsJson(const Metrics& m) {
     kv.emplace_back("memory.rss_mb." + process + ".middle", num(r.middle_mb));
     kv.emplace_back("memory.rss_mb." + process + ".end", num(r.end_mb));
   }
+  if (m.map) {
+    const MapScore& s = m.map->score;
+    kv.emplace_back("map.sa", num(s.sa));
+    kv.emplace_back("map.da", num(s.da));
+    kv.emplace_back("map.aa", num(s.aa));
+    kv.emplace_back("map.voxel_m", num(s.voxel_m));
+    kv.emplace_back("map.static_voxels", std::to_string(s.static_voxels));
+    kv.emplace_back("map.dynamic_voxels", std::to_string(s.dynamic_voxels));
+    kv.emplace_back("map.keyframes", std::to_string(m.map->keyframes));
+    kv.emplace_back("map.points", std::to_string(m.map->map_points));
+    kv.emplace_back("map.loops_accepted", std::to_string(m.map->loops_accepted));
+    kv.emplace_back("map.loops_false", m.map->loops_false ? std::to_string(*m.map->loops_false) : "null");
+    kv.emplace_back("map.end_to_start_m", num(m.map->end_to_start_m));
+    kv.emplace_back("map.slot_end_to_start_m", num(m.map->slot_end_to_start_m));
+  }
   std::string out = "{\n";
   for (size_t i = 0; i < kv.size(); ++i)
     out += "  " + quoted(kv[i].first) + ": " + kv[i].second + (i + 1 < kv.size() ? ",\n" : "\n");
@@ -358,6 +373,16 @@ std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plo
     char buf[32];
     auto mb = [&](double v) { std::snprintf(buf, sizeof buf, "%.1f", v); return std::string(buf); };
     for (const auto& [process, r] : m.memory) t.row({process, mb(r.start_mb), mb(r.middle_mb), mb(r.end_mb)});
+    out << t.render() << "\n";
+  }
+  if (m.map) {
+    const MapScore& s = m.map->score;
+    out << "## Static map (dlslot-mapper; dynamic-map benchmark terms on a " << s.voxel_m << " m voxel grid)\n\n";
+    Table t({"AA", "SA", "DA", "static voxels", "dynamic voxels", "keyframes", "map points", "loops accepted",
+             "false loops"});
+    t.row({cell(s.aa, "%.4f"), cell(s.sa, "%.4f"), cell(s.da, "%.4f"), std::to_string(s.static_voxels),
+           std::to_string(s.dynamic_voxels), std::to_string(m.map->keyframes), std::to_string(m.map->map_points),
+           std::to_string(m.map->loops_accepted), m.map->loops_false ? std::to_string(*m.map->loops_false) : "-"});
     out << t.render() << "\n";
   }
   if (!m.notes.empty()) {

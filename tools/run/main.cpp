@@ -129,7 +129,7 @@ int runPipeline(int argc, char** argv) {
   constexpr int kNotGiven = std::numeric_limits<int>::min();
   int frames = kNotGiven, seed = 1, in_flight = 2;
   double speed = std::numeric_limits<double>::quiet_NaN(), stall_s = 60, start_timeout_s = 30, heartbeat_s = 10;
-  bool no_eval = false, no_render = false, quiet = false, allow_loss = false, insecure = false;
+  bool no_eval = false, no_render = false, no_map = false, quiet = false, allow_loss = false, insecure = false;
   std::string key_file, make_key;
   CommandLine cl("dlslot-run", "Runs player, odometry, tracker, backend, renderer and lcm-logger on one sequence.");
   cl.option("--kitti", &root, "KITTI root (holding training/ or sequences/)");
@@ -155,6 +155,7 @@ int runPipeline(int argc, char** argv) {
   cl.flag("--allow-loss", &allow_loss, "exit 0 even when frames were lost (they are still reported)");
   cl.flag("--no-eval", &no_eval, "skip the evaluation");
   cl.flag("--no-render", &no_render, "do not start the renderer");
+  cl.flag("--no-map", &no_map, "do not start the mapper (no map.pcd, map.png, trajectory_map_*)");
   cl.flag("--quiet", &quiet, "no progress line");
   cl.option("--key", &key_file,
             "authenticate the run's messages with this key file (0600; the same file on every machine of the run); "
@@ -224,8 +225,10 @@ int runPipeline(int argc, char** argv) {
     ConfigSection cfg = loadConfig(config);  // throws a clear ConfigError
     (void)cfg;
     fs::copy_file(config, out + "/config.yaml", fs::copy_options::overwrite_existing);
-    for (const std::string p : {"player", "detector", "odometry", "tracker", "backend", "renderer", "foxglove"}) {
-      if ((no_render && p == "renderer") || (!geometric && p == "detector") || (!foxglove && p == "foxglove")) continue;
+    for (const std::string p : {"player", "detector", "odometry", "tracker", "backend", "renderer", "mapper", "foxglove"}) {
+      if ((no_render && p == "renderer") || (!geometric && p == "detector") || (!foxglove && p == "foxglove") ||
+          (no_map && p == "mapper"))
+        continue;
       const std::string log = logs + "/check-" + p + ".log";
       if (runToEnd(sup, "check-" + p, {bin + "/dlslot-" + p, "--config", config, "--check-config"}, log) != 0)
         throw ConfigError("dlslot-" + p + " refused the config:\n" + run::readText(log));
@@ -308,6 +311,12 @@ int runPipeline(int argc, char** argv) {
     std::vector<std::string> render_args = {"--out", out + "/bev"};
     if (speed > 0) render_args.push_back("--skip-when-behind");
     sup.start("renderer", args(bin + "/dlslot-renderer", render_args), logs + "/renderer.log");
+  }
+  if (!no_map) {
+    // The mapper is not on the lockstep path (the player waits for SLOT_STATE only); it writes
+    // the map files into the run folder when it is stopped.
+    pipeline.insert(pipeline.begin(), "mapper");
+    sup.start("mapper", args(bin + "/dlslot-mapper", {"--out", out}), logs + "/mapper.log");
   }
   sup.start("backend", args(bin + "/dlslot-backend", {"--mode", ms.backend}), logs + "/backend.log");
   // Lockstep with two frames in flight: the player publishes frame t+1 once SLOT_STATE carried
@@ -455,11 +464,13 @@ int runPipeline(int argc, char** argv) {
   // logger closes the log).
   // The launcher keeps reading while it waits, so each process's last PROCESS_STATUS is heard.
   const auto listen = [&] { node.spinUntil([] { return false; }, 0.02); };
-  for (const std::string p : {"detector", "odometry", "tracker", "backend", "renderer", "foxglove"}) {
+  for (const std::string p : {"detector", "odometry", "tracker", "backend", "mapper", "renderer", "foxglove"}) {
     if ((p == std::string("renderer") && no_render) || (p == std::string("detector") && !geometric) ||
-        (p == std::string("foxglove") && !foxglove))
+        (p == std::string("foxglove") && !foxglove) || (p == std::string("mapper") && no_map))
       continue;
-    const int code = sup.stop(p, p == std::string("renderer") ? 60.0 : 10.0, listen);
+    // The mapper finishes its keyframes and loop closure and writes the map files before it exits.
+    const double grace = p == std::string("renderer") ? 60.0 : p == std::string("mapper") ? 120.0 : 10.0;
+    const int code = sup.stop(p, grace, listen);
     if (code != 0) throw Failure(p + " did not exit cleanly (code " + std::to_string(code) + "):\n" + sup.tail(p));
   }
   // UDP datagrams the kernel dropped in this namespace during the run on sockets that do not
@@ -479,10 +490,10 @@ int runPipeline(int argc, char** argv) {
   std::vector<std::pair<std::string, double>> cpu_ms;
   {
     std::string line;
-    for (const std::string p : {"odometry", "detector", "tracker", "backend", "renderer", "foxglove", "player",
+    for (const std::string p : {"odometry", "detector", "tracker", "backend", "mapper", "renderer", "foxglove", "player",
                                 "lcm-logger"}) {
       if ((p == std::string("renderer") && no_render) || (p == std::string("foxglove") && !foxglove) ||
-          (p == std::string("detector") && !geometric))
+          (p == std::string("detector") && !geometric) || (p == std::string("mapper") && no_map))
         continue;
       const double s = sup.cpuSeconds(p);
       if (s < 0) continue;
@@ -522,15 +533,18 @@ int runPipeline(int argc, char** argv) {
 
   // 6. Evaluate and export.
   if (!no_eval) {
-    const std::vector<std::string> eval = {bin + "/dlslot-eval", "--config", config, "--log", out + "/run.lcmlog",
-                                           "--kitti", root, "--sequence", sequence, "--out", out, "--export", out};
+    std::vector<std::string> eval = {bin + "/dlslot-eval", "--config", config, "--log", out + "/run.lcmlog",
+                                     "--kitti", root, "--sequence", sequence, "--out", out, "--export", out};
+    if (!no_map) eval.insert(eval.end(), {"--map", out});
     if (runToEnd(sup, "eval", eval, logs + "/eval.log") != 0) throw Failure("dlslot-eval failed:\n" + sup.tail("eval", 30));
     std::cout << run::readText(logs + "/eval.log");
   }
   std::cout << "outputs in " << out << ": run.lcmlog, speed.yaml, trajectory_*.txt, tracks_kitti.txt, metrics.json, report.md, "
-            << (no_render ? "" : "bev/, ") << "plots/, config.yaml, logs/\n";
+            << (no_render ? "" : "bev/, ") << (no_map ? "" : "map.pcd, map_removed.pcd, map.png, ")
+            << "plots/, config.yaml, logs/\n";
   std::cout << "to look at it: report.md has every table; " << (no_render ? "" : "bev/ one bird's-eye image a frame "
             "(points, boxes coloured by track with id and speed, the trajectories; any image viewer), ")
+            << (no_map ? "" : "map.png the static map from above, map.pcd in any point-cloud viewer, ")
             << "plots/ the trajectories and their errors\n";
   std::cout << std::flush;
   std::cerr << "dlslot-run: " << accounting.verdict() << "\n";

@@ -1,0 +1,221 @@
+#include "mapper/loop_closer.hpp"
+
+#include <chrono>
+#include <unordered_set>
+
+#include "dlslot/voxel_key.hpp"
+
+namespace dlslot::mapper {
+
+PointCloud voxelDownsample(const PointCloud& points, double voxel_m) {
+  std::unordered_set<uint64_t> seen;
+  seen.reserve(points.cols());
+  std::vector<Eigen::Index> keep;
+  for (Eigen::Index i = 0; i < points.cols(); ++i)
+    if (seen.insert(voxelKey(points.col(i).head<3>().cast<double>(), voxel_m)).second) keep.push_back(i);
+  PointCloud out(4, static_cast<Eigen::Index>(keep.size()));
+  for (size_t k = 0; k < keep.size(); ++k) out.col(static_cast<Eigen::Index>(k)) = points.col(keep[k]);
+  return out;
+}
+
+LoopCloser::LoopCloser(const LoopConfig& config, bool threaded) : config_(config), threaded_(threaded) {
+  sc_params_.rings = config.rings;
+  sc_params_.sectors = config.sectors;
+  sc_params_.max_radius_m = config.max_radius_m;
+  if (threaded_) worker_ = std::thread([this] { work(); });
+}
+
+LoopCloser::~LoopCloser() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+void LoopCloser::add(KeyframeInput kf) {
+  if (!threaded_) {
+    process(std::move(kf));
+    return;
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queue_.push_back(std::move(kf));
+  }
+  wake_.notify_one();
+}
+
+void LoopCloser::drain() {
+  if (!threaded_) return;
+  std::unique_lock<std::mutex> lock(mutex_);
+  idle_.wait(lock, [this] { return queue_.empty() && !busy_; });
+}
+
+void LoopCloser::work() {
+  for (;;) {
+    KeyframeInput kf;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // stopping
+      kf = std::move(queue_.front());
+      queue_.pop_front();
+      busy_ = true;
+    }
+    process(std::move(kf));
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      busy_ = false;
+    }
+    idle_.notify_all();
+  }
+}
+
+void LoopCloser::process(KeyframeInput in) {
+  const auto start = std::chrono::steady_clock::now();
+  Keyframe kf;
+  kf.frame = in.frame;
+  kf.odometry = in.odometry;
+  kf.cloud = voxelDownsample(in.points, config_.registration_voxel_m);
+  kf.descriptor = makeScanContext(kf.cloud, sc_params_);
+  const int id = static_cast<int>(keyframes_.size());
+  if (id > 0) {
+    const Keyframe& prev = keyframes_.back();
+    const Pose T_ab = prev.odometry.inverse() * kf.odometry;
+    const double d = T_ab.translation().norm();
+    kf.path_m = prev.path_m + d;
+    // The node starts where the current correction puts it: the previous node's pose times the
+    // odometry's motion.
+    graph_.addNode(graph_.pose(id - 1) * T_ab);
+    Vector6d sigma;
+    const double st = 0.01 + config_.odometry_sigma_t * d, sr = 0.001 + config_.odometry_sigma_r * d;
+    sigma << st, st, st, sr, sr, sr;
+    graph_.addOdometryEdge(id - 1, id, T_ab, sigma);
+  } else {
+    graph_.addNode(kf.odometry);
+  }
+  keyframes_.push_back(std::move(kf));
+  const Keyframe& q = keyframes_.back();
+
+  std::optional<LoopEvent> event;
+  if (config_.enabled && id >= quiet_until_) {
+    const Pose T_q = graph_.pose(id);
+    // Two ways to a candidate: the best Scan Context among the keyframes near the current
+    // estimate (a place seen again from anywhere on it), and the nearest keyframe by position
+    // (LIO-SAM's radius search: a place passed again tens of metres away, where an egocentric
+    // descriptor no longer matches but the scans still overlap). Both lie at least
+    // min_separation_m back along the path; the descriptor's one is verified first.
+    int best = -1, nearest = -1;
+    ScanContextMatch best_match;
+    double nearest_m = config_.search_radius_m;
+    for (int j = 0; j < id; ++j) {
+      const Keyframe& c = keyframes_[j];
+      if (q.path_m - c.path_m < config_.min_separation_m) break;  // path_m grows with j
+      const double d = (graph_.pose(j).translation() - T_q.translation()).norm();
+      if (d > config_.search_radius_m) continue;
+      if (d <= nearest_m) {
+        nearest_m = d;
+        nearest = j;
+      }
+      const ScanContextMatch m = compare(q.descriptor, c.descriptor);
+      if (m.distance < best_match.distance) {
+        best_match = m;
+        best = j;
+      }
+    }
+    if (!(best >= 0 && best_match.distance <= config_.max_descriptor_distance)) best = -1;
+    // A nearest-keyframe candidate is verified once every few keyframes (the query moves on by
+    // metres between them; verification is the costly part).
+    const int candidate = best >= 0 ? best : (nearest >= 0 && id % 5 == 0 ? nearest : -1);
+    if (candidate >= 0) {
+      const Keyframe& c = keyframes_[candidate];
+      const Pose T_c = graph_.pose(candidate);
+      const Pose prior = T_c.inverse() * T_q;
+      // The match side is a local map: the candidate and its neighbours in its frame.
+      const int lo = std::max(0, candidate - config_.submap_keyframes), hi = std::min(id - 1, candidate + config_.submap_keyframes);
+      std::vector<PointCloud> parts;
+      Eigen::Index n = 0;
+      for (int j = lo; j <= hi; ++j) {
+        if (q.path_m - keyframes_[j].path_m < config_.min_separation_m) break;
+        const Pose T_cj = T_c.inverse() * graph_.pose(j);
+        PointCloud part = keyframes_[j].cloud;
+        for (Eigen::Index i = 0; i < part.cols(); ++i) part.col(i).head<3>() = (T_cj * part.col(i).head<3>().cast<double>()).cast<float>();
+        n += part.cols();
+        parts.push_back(std::move(part));
+      }
+      PointCloud submap(4, n);
+      n = 0;
+      for (const PointCloud& part : parts) {
+        submap.middleCols(n, part.cols()) = part;
+        n += part.cols();
+      }
+      submap = voxelDownsample(submap, config_.registration_voxel_m);
+      LoopEvent e;
+      e.query_keyframe = id;
+      e.match_keyframe = candidate;
+      e.query_frame = q.frame;
+      e.match_frame = c.frame;
+      e.descriptor_distance = compare(q.descriptor, c.descriptor).distance;
+      e.verdict = verifyLoop(q.cloud, submap, prior, q.path_m - c.path_m, config_);
+      if (e.verdict.accepted) {
+        Vector6d sigma;
+        sigma << config_.loop_sigma_t, config_.loop_sigma_t, config_.loop_sigma_t, config_.loop_sigma_r,
+            config_.loop_sigma_r, config_.loop_sigma_r;
+        graph_.addLoopEdge(candidate, id, e.verdict.registration.T_match_query, sigma);
+        graph_.optimize();
+        // The next loop is looked for a few keyframes on: neighbours of an accepted loop repeat it.
+        quiet_until_ = id + 10;
+      }
+      event = e;
+    }
+  }
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::lock_guard<std::mutex> lock(mutex_);
+  times_ms_.push_back(ms);
+  if (event) {
+    new_events_.push_back(*event);
+    events_.push_back(*event);
+  }
+  if (event && event->verdict.accepted) optimized_ = graph_.poses();
+}
+
+std::optional<std::vector<Pose>> LoopCloser::takeOptimizedPoses() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::optional<std::vector<Pose>> out;
+  out.swap(optimized_);
+  return out;
+}
+
+std::vector<LoopEvent> LoopCloser::takeEvents() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<LoopEvent> out;
+  out.swap(new_events_);
+  return out;
+}
+
+std::vector<LoopEvent> LoopCloser::allEvents() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return events_;
+}
+
+int LoopCloser::accepted() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  int n = 0;
+  for (const LoopEvent& e : events_) n += e.verdict.accepted;
+  return n;
+}
+
+int LoopCloser::rejected() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  int n = 0;
+  for (const LoopEvent& e : events_) n += !e.verdict.accepted;
+  return n;
+}
+
+std::vector<double> LoopCloser::timesMs() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return times_ms_;
+}
+
+}  // namespace dlslot::mapper

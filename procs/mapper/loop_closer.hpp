@@ -1,0 +1,93 @@
+// Place recognition, verification and the pose graph, on a thread of their own so that the map
+// keeps up with the scans whatever a verification costs. Each keyframe (its static points in its
+// own frame and its SLOT pose) gets a Scan Context; the candidates are keyframes at least
+// min_separation_m back along the path and within search_radius_m of it by the current estimate;
+// the best one by descriptor distance is verified (loop_verifier.hpp), and an accepted loop
+// becomes a loop edge and the graph is re-optimized.
+#pragma once
+
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "mapper/loop_verifier.hpp"
+#include "mapper/mapper_config.hpp"
+#include "mapper/pose_graph.hpp"
+#include "mapper/scan_context.hpp"
+
+namespace dlslot::mapper {
+
+struct KeyframeInput {
+  int id = 0;     // 0, 1, 2, ... in order
+  int frame = 0;  // scan index
+  Pose odometry = Pose::Identity();  // T_world_lidar from SLOT_STATE
+  PointCloud points;                 // static points, lidar frame
+};
+
+struct LoopEvent {
+  int query_keyframe = 0, match_keyframe = 0;
+  int query_frame = 0, match_frame = 0;
+  double descriptor_distance = 1;
+  LoopVerdict verdict;
+};
+
+class LoopCloser {
+ public:
+  // threaded: verification on a worker thread (live); else inline in add() (offline, reproducible).
+  LoopCloser(const LoopConfig& config, bool threaded);
+  ~LoopCloser();
+  LoopCloser(const LoopCloser&) = delete;
+  LoopCloser& operator=(const LoopCloser&) = delete;
+
+  void add(KeyframeInput keyframe);
+  // Waits until every keyframe added so far is handled.
+  void drain();
+
+  // The optimized poses T_map_keyframe of keyframes 0..n-1, when they changed since the last call.
+  std::optional<std::vector<Pose>> takeOptimizedPoses();
+  // Loop candidates verified since the last call.
+  std::vector<LoopEvent> takeEvents();
+  // Every verified candidate so far.
+  std::vector<LoopEvent> allEvents() const;
+  int accepted() const;
+  int rejected() const;
+  // Milliseconds per keyframe spent here (descriptor, search, verification, optimization).
+  std::vector<double> timesMs() const;
+
+ private:
+  void work();
+  void process(KeyframeInput kf);
+
+  struct Keyframe {
+    int frame = 0;
+    Pose odometry;
+    double path_m = 0;
+    ScanContext descriptor;
+    PointCloud cloud;  // downsampled to registration_voxel_m
+  };
+  LoopConfig config_;
+  ScanContextParams sc_params_;
+  bool threaded_;
+  // Owned by the worker.
+  std::vector<Keyframe> keyframes_;
+  PoseGraph graph_;
+  int quiet_until_ = -1;  // no search before this keyframe (just after an accepted loop)
+
+  mutable std::mutex mutex_;
+  std::condition_variable wake_, idle_;
+  std::deque<KeyframeInput> queue_;
+  bool busy_ = false, stop_ = false;
+  std::optional<std::vector<Pose>> optimized_;
+  std::vector<LoopEvent> new_events_, events_;
+  std::vector<double> times_ms_;
+  std::thread worker_;
+};
+
+// One point per voxel (the first), for registration clouds.
+PointCloud voxelDownsample(const PointCloud& points, double voxel_m);
+
+}  // namespace dlslot::mapper

@@ -1,0 +1,124 @@
+#include "mapper/loop_verifier.hpp"
+
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/point_types.h>
+#include <pcl/registration/gicp.h>
+
+#include <cmath>
+#include <sstream>
+
+namespace dlslot::mapper {
+namespace {
+
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+
+Cloud::Ptr toPcl(const PointCloud& points) {
+  Cloud::Ptr c(new Cloud);
+  c->reserve(points.cols());
+  for (Eigen::Index i = 0; i < points.cols(); ++i) c->push_back(pcl::PointXYZ(points(0, i), points(1, i), points(2, i)));
+  return c;
+}
+
+// Overlap of the query's structure with the match after T_match_query.
+void score(const PointCloud& query, const pcl::KdTreeFLANN<pcl::PointXYZ>& tree, const Pose& T, double inlier_m,
+           Registration& r) {
+  int structure = 0, inliers = 0;
+  double sq = 0;
+  std::vector<int> index(1);
+  std::vector<float> d2(1);
+  for (Eigen::Index i = 0; i < query.cols(); ++i) {
+    if (query(2, i) < kGroundBelowZ) continue;
+    ++structure;
+    const Eigen::Vector3d p = T * query.col(i).head<3>().cast<double>();
+    if (tree.nearestKSearch(pcl::PointXYZ(p.x(), p.y(), p.z()), 1, index, d2) == 1 && d2[0] <= inlier_m * inlier_m) {
+      ++inliers;
+      sq += d2[0];
+    }
+  }
+  r.inlier_ratio = structure ? double(inliers) / structure : 0.0;
+  r.rmse_m = inliers ? std::sqrt(sq / inliers) : 0.0;
+}
+
+Registration align(const Cloud::Ptr& query, const Cloud::Ptr& match, const PointCloud& query_points,
+                   const pcl::KdTreeFLANN<pcl::PointXYZ>& tree, const Pose& initial, const LoopConfig& c) {
+  pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> gicp;
+  gicp.setInputSource(query);
+  gicp.setInputTarget(match);
+  gicp.setMaxCorrespondenceDistance(c.max_correspondence_m);
+  gicp.setMaximumIterations(50);
+  gicp.setTransformationEpsilon(1e-6);
+  Cloud aligned;
+  gicp.align(aligned, initial.matrix().cast<float>());
+  Registration r;
+  r.converged = gicp.hasConverged();
+  r.T_match_query.matrix() = gicp.getFinalTransformation().cast<double>();
+  r.T_match_query.linear() = Eigen::Quaterniond(r.T_match_query.rotation()).normalized().toRotationMatrix();
+  score(query_points, tree, r.T_match_query, c.inlier_distance_m, r);
+  return r;
+}
+
+double angleDeg(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle() * 180.0 / M_PI; }
+
+}  // namespace
+
+Registration registerClouds(const PointCloud& query, const PointCloud& match, const Pose& initial, const LoopConfig& c) {
+  const Cloud::Ptr q = toPcl(query), m = toPcl(match);
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  tree.setInputCloud(m);
+  return align(q, m, query, tree, initial, c);
+}
+
+LoopVerdict verifyLoop(const PointCloud& query, const PointCloud& match, const Pose& prior, double path_m,
+                       const LoopConfig& c) {
+  LoopVerdict v;
+  if (query.cols() < 100 || match.cols() < 100) {
+    v.reason = "too few points";
+    return v;
+  }
+  const Cloud::Ptr q = toPcl(query), m = toPcl(match);
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  tree.setInputCloud(m);
+  const Registration best = align(q, m, query, tree, prior, c);
+  v.registration = best;
+  std::ostringstream why;
+  if (!best.converged) {
+    v.reason = "registration did not converge";
+    return v;
+  }
+  if (best.inlier_ratio < c.min_inlier_ratio || best.rmse_m > c.max_rmse_m) {
+    why.precision(3);
+    why << "overlap: inlier ratio " << best.inlier_ratio << " (min " << c.min_inlier_ratio << "), rmse "
+        << best.rmse_m << " m (max " << c.max_rmse_m << ")";
+    v.reason = why.str();
+    return v;
+  }
+  const Pose change = prior.inverse() * best.T_match_query;
+  const double max_t = 1.0 + c.max_drift_fraction * path_m, max_r = 2.0 + path_m / 100.0;
+  if (change.translation().norm() > max_t || angleDeg(change.rotation()) > max_r) {
+    why.precision(3);
+    why << "drift bound: the registration moves the query " << change.translation().norm() << " m / "
+        << angleDeg(change.rotation()) << " deg from the odometry's estimate (max " << max_t << " m / " << max_r
+        << " deg after " << path_m << " m)";
+    v.reason = why.str();
+    return v;
+  }
+  // Uniqueness: from starts shifted along the query's x and y, the registration must return to
+  // the same pose or end clearly worse.
+  for (const Eigen::Vector3d& shift : {Eigen::Vector3d(c.ambiguity_shift_m, 0, 0), Eigen::Vector3d(-c.ambiguity_shift_m, 0, 0),
+                                      Eigen::Vector3d(0, c.ambiguity_shift_m, 0), Eigen::Vector3d(0, -c.ambiguity_shift_m, 0)}) {
+    const Pose start = best.T_match_query * Eigen::Translation3d(shift);
+    const Registration alt = align(q, m, query, tree, start, c);
+    const double apart = (alt.T_match_query.translation() - best.T_match_query.translation()).norm();
+    if (apart > 0.5 && alt.inlier_ratio >= c.ambiguity_ratio * best.inlier_ratio) {
+      why.precision(3);
+      why << "ambiguous: a start " << shift.norm() << " m off ends " << apart << " m away with inlier ratio "
+          << alt.inlier_ratio << " (best " << best.inlier_ratio << ")";
+      v.reason = why.str();
+      return v;
+    }
+  }
+  v.accepted = true;
+  return v;
+}
+
+}  // namespace dlslot::mapper

@@ -1,0 +1,47 @@
+// Verifying a loop candidate: the two keyframes' clouds registered (PCL's generalized ICP,
+// Segal et al. 2009), then a strict acceptance test. A false loop bends the whole trajectory, a
+// missed one only leaves drift, so a candidate must pass all of:
+//   1. overlap: most of the query's structure (points off the ground) lies within
+//      inlier_distance of the match after alignment, with a small RMS distance;
+//   2. drift bound: the registration moves the query at most 1 m + max_drift_fraction x the path
+//      driven since the match (and 2 deg + 1 deg per 100 m) away from where the odometry puts it:
+//      anything farther is not drift but a wrong place;
+//   3. uniqueness: registrations started ambiguity_shift_m off along x and y must come back to
+//      the same pose, or end clearly worse. Guard rails with posts, rows of parked cars and
+//      corridors align equally well at several shifts; such a place cannot tell where along
+//      it the vehicle is, so it is refused.
+#pragma once
+
+#include <string>
+
+#include "dlslot/types.hpp"
+#include "mapper/mapper_config.hpp"
+
+namespace dlslot::mapper {
+
+struct Registration {
+  Pose T_match_query = Pose::Identity();
+  bool converged = false;
+  double inlier_ratio = 0;  // share of the query's points off the ground within inlier_distance
+  double rmse_m = 0;        // RMS distance of those inliers
+};
+
+struct LoopVerdict {
+  bool accepted = false;
+  std::string reason;  // the failed test, "" when accepted
+  Registration registration;
+};
+
+// Clouds: x y z columns in each keyframe's lidar frame (intensity unused).
+Registration registerClouds(const PointCloud& query, const PointCloud& match, const Pose& initial,
+                            const LoopConfig& config);
+
+// prior: T_match_query from the current trajectory estimate; path_m: distance driven between them.
+LoopVerdict verifyLoop(const PointCloud& query, const PointCloud& match, const Pose& prior, double path_m,
+                       const LoopConfig& config);
+
+// Points below this height in the lidar frame are the road: they align at any shift along it, so
+// they take part in the registration but not in the overlap and uniqueness scores.
+inline constexpr double kGroundBelowZ = -1.3;
+
+}  // namespace dlslot::mapper

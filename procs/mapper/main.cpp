@@ -1,0 +1,192 @@
+// dlslot-mapper: LIDAR_SCAN + SLOT_STATE -> the static map without moving objects, loop closure
+// and the loop-closed trajectory; MAP_STATE every scan, the map files on exit. Live over LCM, or
+// offline from a recorded run (--offline RUN.lcmlog --out DIR).
+#include <lcm/lcm-cpp.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <numeric>
+
+#include "dlslot/convert.hpp"
+#include "dlslot/frame_joiner.hpp"
+#include "dlslot/lcm_log.hpp"
+#include "dlslot/node.hpp"
+#include "dlslot/point_cloud_t.hpp"
+#include "dlslot/progress.hpp"
+#include "dlslot/timing_stats.hpp"
+#include "mapper/map_output.hpp"
+#include "mapper/mapper_messages.hpp"
+
+using namespace dlslot;
+using namespace dlslot::mapper;
+
+namespace {
+
+using Joiner = FrameJoiner<PointCloud, MapperInput>;
+
+double nowSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+void printSummary(const Mapper& mapper, const std::string& out, const std::vector<std::string>& files) {
+  const std::vector<double> t = mapper.loops().timesMs();
+  TimingStats loop;
+  for (double ms : t) loop.add(ms);
+  std::printf("mapper: %zu keyframes, map %zu voxels (%.2f m), removed %zu voxels; loops: %d accepted, %d refused\n",
+              mapper.keyframes().size(), mapper.map().size(), mapper.map().voxelSize(), mapper.removed().size(),
+              mapper.loops().accepted(), mapper.loops().rejected());
+  std::printf("  per keyframe: removal + map %.2f ms mean; loop thread (descriptor, search, verification, graph) %.2f ms "
+              "mean, %.2f p95, %.1f max\n",
+              mapper.keyframes().empty() ? 0.0 : mapper.keyframeMs() / mapper.keyframes().size(), loop.mean(),
+              loop.percentile(95), loop.max());
+  for (const LoopEvent& e : mapper.loops().allEvents())
+    std::printf("  loop %d -> %d: %s (descriptor %.3f, inliers %.2f, rmse %.3f m)%s%s\n", e.query_frame, e.match_frame,
+                e.verdict.accepted ? "accepted" : "refused", e.descriptor_distance, e.verdict.registration.inlier_ratio,
+                e.verdict.registration.rmse_m, e.verdict.accepted ? "" : ": ", e.verdict.reason.c_str());
+  if (!out.empty()) {
+    std::printf("  wrote to %s:", out.c_str());
+    for (const std::string& f : files) std::printf(" %s", f.c_str());
+    std::printf("\n");
+  }
+}
+
+int runOffline(const MapperConfig& config, const Channels& channels, const std::string& in_path, const std::string& out) {
+  lcm::LogFile in(in_path, "r");
+  if (!in.good()) throw std::runtime_error(in_path + ": cannot open LCM log for reading");
+  namespace fs = std::filesystem;
+  const auto total = fs::file_size(in_path);
+  Mapper mapper(config, /*threaded=*/false);
+  Joiner joiner(std::numeric_limits<double>::infinity());
+  ProcessStatus guard("mapper");
+  std::map<std::string, FrameOrder> order;
+  ProgressLine progress("mapper " + fs::path(in_path).filename().string() + " (% of the log)", 100);
+  int frames = 0, missing = 0;
+  auto handle = [&](std::vector<Joiner::Joined> ready) {
+    for (Joiner::Joined& j : ready) {
+      if (!j.a || !j.b) {
+        ++missing;
+        continue;
+      }
+      j.b->scan = std::move(*j.a);
+      mapper.add(*j.b);
+      ++frames;
+    }
+  };
+  int64_t index = 0;
+  for (; const lcm::LogEvent* ev = nextLogEvent(in, in_path); ++index) {
+    const bool scan = ev->channel == channels.scan, slot = ev->channel == channels.slot_state;
+    if (!scan && !slot) continue;
+    const std::string where = in_path + ": event " + std::to_string(index) + ": ";
+    const size_t size = static_cast<size_t>(std::max(ev->datalen, 0));
+    if (scan) {
+      point_cloud_t m;
+      Refusal why = decodeChecked(ev->data, size, &m);
+      if (!why) why = order[ev->channel].accept(m.frame);
+      if (why) guard.refused(ev->channel, why, where);
+      else joiner.addA(m.frame, fromMsg(m), 0.0);
+    } else {
+      slot_state_t m;
+      Refusal why = decodeChecked(ev->data, size, &m);
+      if (!why) why = order[ev->channel].accept(m.frame);
+      if (why) guard.refused(ev->channel, why, where);
+      else joiner.addB(m.frame, inputFromMsg(m), 0.0);
+    }
+    handle(joiner.release(0.0));
+    if (index % 50 == 0)
+      progress.update(static_cast<int>(100.0 * std::ftell(in.getFilePtr()) / std::max<double>(1, total)),
+                      std::to_string(frames) + " scans");
+  }
+  handle(joiner.flush());
+  mapper.finish();
+  progress.finish(std::to_string(frames) + " scans");
+  std::printf("mapper: %d scans with their SLOT_STATE, %d with one of the two missing\n", frames, missing);
+  for (const auto& [what, n] : guard.refusals()) std::printf("  refused %s: %lld\n", what.c_str(), static_cast<long long>(n));
+  const std::vector<std::string> files = out.empty() ? std::vector<std::string>{} : writeMapOutputs(out, mapper);
+  printSummary(mapper, out, files);
+  return 0;
+}
+
+int runLive(const MapperConfig& config, const Channels& channels, const NodeOptions& opts, const std::string& out) {
+  Node node("mapper", opts.lcm_url, channels);
+  Mapper mapper(config, /*threaded=*/true);
+  Joiner joiner(config.join_timeout_s);
+  auto handleReady = [&] {
+    for (Joiner::Joined& j : joiner.release(nowSeconds())) {
+      if (!j.a) node.status().timeout("LIDAR_SCAN of frame " + std::to_string(j.frame));
+      if (!j.b) node.status().timeout("SLOT_STATE of frame " + std::to_string(j.frame));
+      if (!j.a || !j.b) continue;
+      const auto start = std::chrono::steady_clock::now();
+      try {
+        const Pose slot_pose = j.b->pose;
+        const int64_t utime = j.b->utime;
+        j.b->scan = std::move(*j.a);
+        mapper.add(*j.b);
+        node.publish(config.channel, mapStateMsg(mapper, j.frame, utime, slot_pose, mapper.loops().takeEvents()));
+        node.status().frameDone(j.frame, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        node.status().set("keyframes", static_cast<int64_t>(mapper.keyframes().size()));
+        node.status().set("map_voxels", static_cast<int64_t>(mapper.map().size()));
+        node.status().set("loops_accepted", mapper.loops().accepted());
+        node.status().set("loops_refused", mapper.loops().rejected());
+      } catch (const std::exception& e) {
+        node.status().error(std::string("frame ") + std::to_string(j.frame) + ": " + e.what());
+      }
+    }
+  };
+  node.subscribeFrames<point_cloud_t>(channels.scan, [&](const point_cloud_t& m) {
+    if (!joiner.addA(m.frame, fromMsg(m), nowSeconds()))
+      node.status().warn("LIDAR_SCAN of frame " + std::to_string(m.frame) + " arrived after the frame was released");
+    handleReady();
+  });
+  node.subscribeFrames<slot_state_t>(channels.slot_state, [&](const slot_state_t& m) {
+    if (!joiner.addB(m.frame, inputFromMsg(m), nowSeconds()))
+      node.status().warn("SLOT_STATE of frame " + std::to_string(m.frame) + " arrived after the frame was released");
+    handleReady();
+  });
+  node.every(0.05, handleReady);
+  const int code = node.run();
+  // Stopped (SIGINT/SIGTERM): what is still waiting goes in, then the files.
+  for (Joiner::Joined& j : joiner.flush())
+    if (j.a && j.b) {
+      j.b->scan = std::move(*j.a);
+      mapper.add(*j.b);
+    }
+  mapper.finish();
+  const std::vector<std::string> files = out.empty() ? std::vector<std::string>{} : writeMapOutputs(out, mapper);
+  printSummary(mapper, out, files);
+  return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return runMain("dlslot-mapper", [&] {
+    NodeOptions opts;
+    std::string offline_in, out, remove;
+    bool no_loops = false;
+    CommandLine cl("dlslot-mapper",
+                   "Static map without moving objects, loop closure and a keyframe pose graph: LIDAR_SCAN + SLOT_STATE "
+                   "-> MAP_STATE and, on exit, map.pcd, map_removed.pcd, map.png, trajectory_map_*.txt in --out.");
+    opts.addTo(cl);
+    cl.option("--offline", &offline_in, "rebuild from this recorded run (LCM log with LIDAR_SCAN and SLOT_STATE)");
+    cl.option("--out", &out, "directory for the map files (written on exit; required with --offline)");
+    cl.option("--remove", &remove, "dynamic (moving tracks) | movable (every track, parked vehicles too); overrides mapper.remove");
+    cl.flag("--no-loops", &no_loops, "no loop closure (the map and trajectory follow SLOT_STATE)");
+    if (!cl.parse(argc, argv)) return 0;
+    if (!offline_in.empty() && out.empty()) throw std::invalid_argument("--offline needs --out DIR");
+    if (!remove.empty() && remove != "dynamic" && remove != "movable")
+      throw std::invalid_argument("--remove: expected dynamic or movable, got '" + remove + "'");
+    Channels channels;
+    ConfigSection root = loadPipelineConfig(opts.config, channels);
+    ConfigSection section = root.section("mapper");
+    MapperConfig config = MapperConfig::read(section);
+    section.finish();
+    if (!remove.empty()) config.remove_movable = remove == "movable";
+    if (no_loops) config.loop.enabled = false;
+    if (opts.check_config) return 0;
+    if (!offline_in.empty()) return runOffline(config, channels, offline_in, out);
+    return runLive(config, channels, opts, out);
+  });
+}

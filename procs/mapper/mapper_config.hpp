@@ -1,0 +1,41 @@
+// The mapper's settings (config section `mapper`, documented in config/dlslot.yaml).
+#pragma once
+
+#include <string>
+
+#include "dlslot/config.hpp"
+
+namespace dlslot::mapper {
+
+struct LoopConfig {
+  bool enabled = true;
+  int rings = 20, sectors = 60;
+  double max_radius_m = 50.0;
+  double min_separation_m = 100.0, search_radius_m = 40.0;
+  double max_descriptor_distance = 0.4;
+  double registration_voxel_m = 0.5, max_correspondence_m = 2.0;
+  int submap_keyframes = 10;  // the match side of a verification: the candidate and this many keyframes either side
+  double inlier_distance_m = 0.3, min_inlier_ratio = 0.4, max_rmse_m = 0.15;
+  double max_drift_fraction = 0.03;
+  double ambiguity_shift_m = 4.0, ambiguity_ratio = 0.9;
+  double odometry_sigma_t = 0.02, odometry_sigma_r = 0.002;
+  double loop_sigma_t = 0.1, loop_sigma_r = 0.01;
+};
+
+struct MapperConfig {
+  std::string channel = "MAP_STATE";
+  double keyframe_distance_m = 1.0, keyframe_angle_deg = 10.0;
+  double min_range_m = 2.5, max_range_m = 50.0;
+  double map_voxel_m = 0.2;
+  bool remove_movable = false;  // remove: movable (every track) instead of dynamic (moving tracks)
+  double box_margin_m = 0.3;
+  double ground_clearance_m = 0.1;
+  int decision_delay_frames = 15, follow_frames = 15;
+  double join_timeout_s = 5.0;  // live: how long a scan waits for its SLOT_STATE (and back)
+  LoopConfig loop;
+
+  // Reads and checks the section; throws ConfigError naming the key and what was expected.
+  static MapperConfig read(ConfigSection& section);
+};
+
+}  // namespace dlslot::mapper

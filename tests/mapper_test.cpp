@@ -1,0 +1,297 @@
+// The mapper's core with known answers: Scan Context's rotation invariance and yaw, the removal
+// boxes followed through missed frames, the voxel map following its keyframes, the pose graph
+// closing a drifted loop, the loop acceptance test on distinct and on repeating structure, and
+// map.pcd read back with PCL.
+#include <gtest/gtest.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
+
+#include <filesystem>
+#include <random>
+
+#include "mapper/loop_verifier.hpp"
+#include "mapper/map_output.hpp"
+#include "mapper/mapper.hpp"
+#include "mapper/pose_graph.hpp"
+#include "mapper/scan_context.hpp"
+#include "mapper/track_boxes.hpp"
+#include "mapper/voxel_map.hpp"
+
+using namespace dlslot;
+using namespace dlslot::mapper;
+
+namespace {
+
+Pose poseXYYaw(double x, double y, double yaw) {
+  Pose T = Pose::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(x, y, 0);
+  return T;
+}
+
+PointCloud toCloud(const std::vector<Eigen::Vector3d>& pts) {
+  PointCloud c(4, static_cast<Eigen::Index>(pts.size()));
+  for (size_t i = 0; i < pts.size(); ++i) c.col(static_cast<Eigen::Index>(i)) << pts[i].cast<float>(), 0.5f;
+  return c;
+}
+
+// The world's points seen from T_world_lidar within `range`, in the lidar frame.
+PointCloud view(const std::vector<Eigen::Vector3d>& world, const Pose& T_world_lidar, double range = 40) {
+  std::vector<Eigen::Vector3d> local;
+  const Pose inv = T_world_lidar.inverse();
+  for (const Eigen::Vector3d& p : world) {
+    const Eigen::Vector3d q = inv * p;
+    if (q.head<2>().norm() <= range) local.push_back(q);
+  }
+  return toCloud(local);
+}
+
+void addGround(std::vector<Eigen::Vector3d>& w, double x0, double x1, double y0, double y1) {
+  for (double x = x0; x <= x1; x += 0.5)
+    for (double y = y0; y <= y1; y += 0.5) w.emplace_back(x, y, -1.73);
+}
+
+void addPole(std::vector<Eigen::Vector3d>& w, double x, double y, double height = 4.0) {
+  for (double z = -1.7; z <= -1.7 + height; z += 0.1)
+    for (int a = 0; a < 8; ++a) w.emplace_back(x + 0.15 * std::cos(a * M_PI / 4), y + 0.15 * std::sin(a * M_PI / 4), z);
+}
+
+// A highway's shoulders: guard rails on both sides with a post every 4 m, nothing else.
+std::vector<Eigen::Vector3d> guardRailWorld() {
+  std::vector<Eigen::Vector3d> w;
+  addGround(w, -100, 100, -8, 8);
+  for (double x = -100; x <= 100; x += 0.1)
+    for (double side : {-7.0, 7.0})
+      for (double z = -1.0; z <= -0.6; z += 0.1) w.emplace_back(x, side, z);
+  for (double x = -100; x <= 100; x += 4.0)
+    for (double side : {-7.2, 7.2}) addPole(w, x, side, 1.0);
+  return w;
+}
+
+// A street with poles, parked boxes and a wall at irregular places.
+std::vector<Eigen::Vector3d> distinctWorld() {
+  std::vector<Eigen::Vector3d> w;
+  addGround(w, -60, 60, -15, 15);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (double x = -60; x < 60; x += 5 + 10 * u(rng)) addPole(w, x, (u(rng) < 0.5 ? -1 : 1) * (8 + 4 * u(rng)));
+  for (double x = -60; x < 60; x += 8 + 12 * u(rng)) {  // parked cars
+    const double y = (u(rng) < 0.5 ? -1 : 1) * 5.5, l = 3.5 + 1.5 * u(rng);
+    for (double dx = 0; dx <= l; dx += 0.15)
+      for (double dz = 0; dz <= 1.4; dz += 0.15) w.emplace_back(x + dx, y, -1.6 + dz);
+  }
+  for (double x = -20; x <= 35; x += 0.2)  // a building front, part of the street only
+    for (double z = -1.7; z <= 6; z += 0.3) w.emplace_back(x, 14, z);
+  return w;
+}
+
+LoopConfig loopConfig() { return LoopConfig(); }
+
+}  // namespace
+
+TEST(ScanContext, ARotatedScanHasTheSameDescriptorShiftedByItsYaw) {
+  const std::vector<Eigen::Vector3d> world = distinctWorld();
+  const PointCloud a = view(world, poseXYYaw(0, 0, 0));
+  // The same place with the sensor turned by 30 deg: p_b = Rz(-30 deg) p_a.
+  const PointCloud b = view(world, poseXYYaw(0, 0, 30 * M_PI / 180));
+  const ScanContextParams p;
+  const ScanContextMatch m = compare(makeScanContext(a, p), makeScanContext(b, p));
+  EXPECT_LT(m.distance, 0.05);
+  EXPECT_NEAR(m.yaw * 180 / M_PI, -30.0, 6.0 + 1e-9);  // one sector is 6 deg
+  // Another place (40 m on) is farther than the same place turned.
+  const PointCloud c = view(world, poseXYYaw(40, 0, 0));
+  EXPECT_GT(compare(makeScanContext(a, p), makeScanContext(c, p)).distance, 3 * m.distance + 0.05);
+}
+
+TEST(ScanContext, ShiftedColumnsGiveZeroDistanceAndTheShift) {
+  ScanContext a;
+  a.cells = Eigen::MatrixXf::Zero(4, 12);
+  for (int j = 0; j < 12; ++j) {  // no two columns parallel
+    a.cells(j % 4, j) = 1.0f + j;
+    a.cells((j + 1) % 4, j) = 0.5f * (12 - j);
+  }
+  ScanContext b;
+  b.cells = Eigen::MatrixXf::Zero(4, 12);
+  for (int j = 0; j < 12; ++j) b.cells.col((j + 5) % 12) = a.cells.col(j);
+  const ScanContextMatch m = compare(a, b);
+  EXPECT_NEAR(m.distance, 0.0, 1e-6);
+  EXPECT_EQ(m.shift, 5);
+  EXPECT_NEAR(m.yaw, 5 * 2 * M_PI / 12, 1e-9);
+}
+
+TEST(TrackBoxes, MovingTracksAreFollowedThroughMissesAndParkedOnesKeptUnlessMovable) {
+  TrackBoxes boxes(0.25, 5, false, 0.1), movable(0.25, 5, true, 0.1);
+  auto snapshot = [](int id, double x, bool dynamic) {
+    TrackSnapshot s;
+    s.id = id;
+    s.box.center = Eigen::Vector3d(x, 0, 0);
+    s.box.size = Eigen::Vector3d(4, 2, 1.5);
+    s.velocity = Eigen::Vector3d(10, 0, 0);
+    s.dynamic = dynamic;
+    return s;
+  };
+  for (int f : {0, 1, 4}) {  // the detector missed the car in frames 2 and 3
+    const std::vector<TrackSnapshot> t = {snapshot(1, 10.0 * f * 0.1 * 10, true), snapshot(2, 50, false)};
+    boxes.add(f, f * 0.1, t);
+    movable.add(f, f * 0.1, t);
+  }
+  // Frame 2: between the sightings at x = 10 (frame 1) and x = 40 (frame 4): x = 20.
+  std::vector<Box> at2 = boxes.removalBoxes(2, 0.2);
+  ASSERT_EQ(at2.size(), 1u);
+  EXPECT_EQ(at2[0].id, 1);
+  EXPECT_NEAR(at2[0].center.x(), 20.0, 1e-9);
+  EXPECT_NEAR(at2[0].size.x(), 4.5, 1e-9);  // grown by the margin on both ends
+  EXPECT_NEAR(at2[0].size.z(), 1.65, 1e-9);  // and on top; its bottom raised by the clearance
+  EXPECT_NEAR(at2[0].center.z() - 0.5 * at2[0].size.z(), -0.75 + 0.1, 1e-9);
+  // Frame 6, two frames after the last sighting: carried at 10 m/s, x = 40 + 2.
+  std::vector<Box> at6 = boxes.removalBoxes(6, 0.6);
+  ASSERT_EQ(at6.size(), 1u);
+  EXPECT_NEAR(at6[0].center.x(), 42.0, 1e-9);
+  EXPECT_TRUE(boxes.removalBoxes(10, 1.0).empty());  // beyond follow_frames
+  EXPECT_EQ(movable.removalBoxes(4, 0.4).size(), 2u);  // the parked car too
+}
+
+TEST(VoxelMap, VoxelsFollowTheirKeyframesWhenTheGraphMovesThem) {
+  VoxelMap map(0.2);
+  const PointCloud pts = toCloud({{1.05, 0.05, 0.05}, {1.06, 0.06, 0.06}, {5.05, 0.05, 0.05}});
+  map.insert(0, Pose::Identity(), pts);
+  map.insert(1, poseXYYaw(10, 0, 0), pts);
+  EXPECT_EQ(map.size(), 4u);  // the first two points share a voxel
+  map.repose({Pose::Identity(), poseXYYaw(10, 2, 0)});
+  const PointCloud c = map.cloud();
+  int moved = 0;
+  for (Eigen::Index i = 0; i < c.cols(); ++i) moved += std::abs(c(1, i) - 2.05f) < 1e-4;
+  EXPECT_EQ(moved, 2);
+  EXPECT_EQ(map.size(), 4u);
+}
+
+TEST(PoseGraph, ALoopEdgeTakesOutTheDriftOfASquare) {
+  // A 40 m square driven in 16 steps; the odometry turns 1 deg too much each step.
+  std::vector<Pose> truth;
+  for (int i = 0; i <= 16; ++i) {
+    const int side = std::min(i / 4, 3), k = i - 4 * side;
+    const double yaw = side * M_PI / 2;
+    Eigen::Vector2d start[4] = {{0, 0}, {40, 0}, {40, 40}, {0, 40}};
+    const Eigen::Vector2d p = start[side] + k * 10.0 * Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
+    truth.push_back(poseXYYaw(p.x(), p.y(), i == 16 ? 2 * M_PI : yaw));
+  }
+  PoseGraph g;
+  Pose odo = truth[0];
+  g.addNode(odo);
+  Vector6d sigma;  // per 10 m step
+  sigma << 0.2, 0.2, 0.2, 0.02, 0.02, 0.02;
+  for (int i = 1; i <= 16; ++i) {
+    Pose step = truth[i - 1].inverse() * truth[i];
+    step = step * poseXYYaw(0, 0, M_PI / 180);
+    odo = odo * step;
+    g.addNode(odo);
+    g.addOdometryEdge(i - 1, i, step, sigma);
+  }
+  const double before = (g.pose(16).translation() - truth[16].translation()).norm();
+  EXPECT_GT(before, 5.0);
+  g.addLoopEdge(0, 16, truth[0].inverse() * truth[16], sigma * 0.25);
+  g.optimize();
+  EXPECT_LT((g.pose(16).translation() - truth[16].translation()).norm(), 0.1);
+  double worst = 0;
+  for (int i = 0; i <= 16; ++i) worst = std::max(worst, (g.pose(i).translation() - truth[i].translation()).norm());
+  EXPECT_LT(worst, 0.35 * before);
+  EXPECT_EQ(g.loopEdges(), 1);
+}
+
+TEST(LoopVerifier, ADistinctPlaceIsAcceptedWithItsPose) {
+  const std::vector<Eigen::Vector3d> world = distinctWorld();
+  const Pose Tm = poseXYYaw(0, 0, 0), Tq = poseXYYaw(1.0, 0.8, 0.05);
+  const Pose truth = Tm.inverse() * Tq;
+  const Pose prior = truth * poseXYYaw(0.6, -0.4, 0.02);  // drift
+  const LoopVerdict v = verifyLoop(view(world, Tq), view(world, Tm), prior, 500.0, loopConfig());
+  EXPECT_TRUE(v.accepted) << v.reason;
+  EXPECT_LT((v.registration.T_match_query.translation() - truth.translation()).norm(), 0.1);
+}
+
+TEST(LoopVerifier, GuardRailsWithRegularPostsAreRefusedAsAmbiguous) {
+  const std::vector<Eigen::Vector3d> world = guardRailWorld();
+  const Pose Tm = poseXYYaw(0, 0, 0), Tq = poseXYYaw(1.0, 0.3, 0.0);
+  const Pose prior = Tm.inverse() * Tq * poseXYYaw(0.5, 0.2, 0.0);
+  const LoopVerdict v = verifyLoop(view(world, Tq), view(world, Tm), prior, 500.0, loopConfig());
+  EXPECT_FALSE(v.accepted);
+  EXPECT_NE(v.reason.find("ambiguous"), std::string::npos) << v.reason;
+}
+
+TEST(LoopVerifier, AnotherPlaceFarFromTheOdometryIsRefused) {
+  const std::vector<Eigen::Vector3d> world = distinctWorld();
+  // The registration of two places 20 m apart, with a prior saying they are 1 m apart after 50 m.
+  const LoopVerdict v =
+      verifyLoop(view(world, poseXYYaw(20, 0, 0)), view(world, poseXYYaw(0, 0, 0)), poseXYYaw(1, 0, 0), 50.0, loopConfig());
+  EXPECT_FALSE(v.accepted);
+}
+
+TEST(MapOutput, MapPcdReadsBackWithPclWithItsPointsAndBounds) {
+  const std::string dir = (std::filesystem::temp_directory_path() / "mapper_test_pcd").string();
+  std::filesystem::create_directories(dir);
+  PointCloud pts(4, 3);
+  pts << 1, -2, 3.5, 0.5, 0.5, 0.5, -1, 0, 4, 0.1f, 0.9f, 0.4f;
+  writePcd(dir + "/map.pcd", pts);
+  pcl::PointCloud<pcl::PointXYZI> back;
+  ASSERT_EQ(pcl::io::loadPCDFile(dir + "/map.pcd", back), 0);
+  ASSERT_EQ(back.size(), 3u);
+  pcl::PointXYZI lo, hi;
+  lo.getVector3fMap() = Eigen::Vector3f::Constant(1e9);
+  hi.getVector3fMap() = Eigen::Vector3f::Constant(-1e9);
+  for (const auto& p : back) {
+    lo.getVector3fMap() = lo.getVector3fMap().cwiseMin(p.getVector3fMap());
+    hi.getVector3fMap() = hi.getVector3fMap().cwiseMax(p.getVector3fMap());
+  }
+  EXPECT_FLOAT_EQ(lo.x, -2);
+  EXPECT_FLOAT_EQ(hi.x, 3.5);
+  EXPECT_FLOAT_EQ(lo.z, -1);
+  EXPECT_FLOAT_EQ(hi.z, 4);
+  EXPECT_FLOAT_EQ(back[2].intensity, 0.4f);
+  std::ifstream in(dir + "/map.pcd");
+  std::string line;
+  bool binary = false;
+  while (std::getline(in, line))
+    if (line.rfind("DATA", 0) == 0) binary = line == "DATA binary";
+  EXPECT_TRUE(binary);
+}
+
+TEST(Mapper, AMovingCarLeavesNoGhostAndTheStaticWorldStays) {
+  // A wall along the road and a car driving past the parked ego; the backend calls it dynamic.
+  MapperConfig config;
+  config.keyframe_distance_m = 0.5;
+  config.decision_delay_frames = 8;
+  config.loop.enabled = false;
+  Mapper mapper(config, false);
+  for (int f = 0; f < 20; ++f) {
+    MapperInput in;
+    in.frame = f;
+    in.utime = f * 100000;
+    in.pose = poseXYYaw(f * 1.0, 0, 0);
+    std::vector<Eigen::Vector3d> pts;
+    for (double x = -20; x <= 20; x += 0.1)
+      for (double z = -1.5; z <= 1.0; z += 0.25) pts.emplace_back(x, 10 - 0.0, z);  // wall, lidar frame (ego moves along x)
+    const double car_x = 5.0 + f * 2.0 - f * 1.0;  // the car, 1 m/s faster than the ego, 5 m ahead, lidar frame
+    for (double dx = -2; dx <= 2; dx += 0.1)  // the body 0.15 m above the box's floor (wheels), to its top
+      for (double dz = -0.6; dz <= 0.7; dz += 0.1) pts.emplace_back(car_x + dx, -3.5, dz - 1.0);
+    in.scan = toCloud(pts);
+    if (f % 4 != 2) {  // detector misses every fourth frame
+      TrackSnapshot t;
+      t.id = 7;
+      t.box.center = in.pose * Eigen::Vector3d(car_x, -3.5, -1.0);
+      t.box.size = Eigen::Vector3d(4.2, 1.8, 1.5);
+      t.velocity = Eigen::Vector3d(20, 0, 0);
+      t.dynamic = f >= 6;  // found to move only at frame 6: earlier keyframes are cleaned too
+      in.tracks.push_back(t);
+    }
+    mapper.add(in);
+  }
+  mapper.finish();
+  const PointCloud map = mapper.map().cloud(), removed = mapper.removed().cloud();
+  int ghost = 0, wall = 0;
+  for (Eigen::Index i = 0; i < map.cols(); ++i) {
+    ghost += std::abs(map(1, i) + 3.5) < 1.0;
+    wall += std::abs(map(1, i) - 10) < 0.2;
+  }
+  EXPECT_EQ(ghost, 0);
+  EXPECT_GT(wall, 1000);
+  EXPECT_GT(removed.cols(), 500);
+}

@@ -1,0 +1,83 @@
+#include "map_quality.hpp"
+
+#include <cmath>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "dlslot/voxel_key.hpp"
+
+namespace dlslot::eval {
+
+std::set<int> movingTracks(const std::map<int, std::vector<Box>>& labels_by_frame, const std::map<int, Pose>& poses,
+                           double moving_span_m) {
+  std::map<int, std::vector<Eigen::Vector3d>> centres;
+  for (const auto& [frame, boxes] : labels_by_frame) {
+    const auto T = poses.find(frame);
+    if (T == poses.end()) continue;
+    for (const Box& b : boxes)
+      if (b.id >= 0) centres[b.id].push_back(T->second * b.center);
+  }
+  std::set<int> moving;
+  for (const auto& [id, c] : centres) {
+    double span = 0;
+    for (size_t i = 0; i < c.size() && span <= moving_span_m; ++i)
+      for (size_t j = i + 1; j < c.size(); ++j) span = std::max(span, (c[i] - c[j]).head<2>().norm());
+    if (span > moving_span_m) moving.insert(id);
+  }
+  return moving;
+}
+
+MapScore scoreMap(const PointCloud& map_points, const std::vector<MapKeyframe>& keyframes, const std::set<int>& moving,
+                  const MapTruthOptions& o) {
+  MapScore s;
+  s.voxel_m = o.voxel_m;
+  std::unordered_set<uint64_t> occupied;
+  occupied.reserve(map_points.cols());
+  for (Eigen::Index i = 0; i < map_points.cols(); ++i) occupied.insert(voxelKey(map_points.col(i).head<3>().cast<double>(), o.voxel_m));
+  std::unordered_map<uint64_t, std::pair<int, int>> votes;  // voxel -> (static, dynamic) points
+  const double lo = o.min_range_m * o.min_range_m, hi = o.max_range_m * o.max_range_m;
+  for (const MapKeyframe& kf : keyframes) {
+    std::vector<const Box*> boxes;
+    for (const Box& b : kf.labels)
+      if (moving.count(b.id)) boxes.push_back(&b);
+    for (Eigen::Index i = 0; i < kf.scan.cols(); ++i) {
+      const Eigen::Vector3d p = kf.scan.col(i).head<3>().cast<double>();
+      const double r2 = p.squaredNorm();
+      if (r2 < lo || r2 > hi) continue;
+      if (o.T_cam_lidar) {
+        const Eigen::Vector3d c = *o.T_cam_lidar * p;  // camera: z forward, x right
+        if (c.z() <= 0 || std::abs(std::atan2(c.x(), c.z())) > o.camera_half_fov_rad) continue;
+      }
+      bool dynamic = false, band = false;
+      for (const Box* b : boxes)
+        if (b->contains(p)) {
+          dynamic = true;
+          band = band || p.z() < b->center.z() - 0.5 * b->size.z() + o.bottom_band_m;
+        }
+      if (band) continue;
+      auto& v = votes[voxelKey(kf.T_map_lidar * p, o.voxel_m)];
+      (dynamic ? v.second : v.first) += 1;
+    }
+  }
+  for (const auto& [key, v] : votes) {
+    const bool kept = occupied.count(key) > 0;
+    if (v.second > v.first) {
+      ++s.dynamic_voxels;
+      s.dynamic_removed += !kept;
+    } else {
+      ++s.static_voxels;
+      s.static_kept += kept;
+    }
+  }
+  if (s.static_voxels) s.sa = double(s.static_kept) / s.static_voxels;
+  if (s.dynamic_voxels) s.da = double(s.dynamic_removed) / s.dynamic_voxels;
+  if (s.sa && s.da) s.aa = std::sqrt(*s.sa * *s.da);
+  return s;
+}
+
+bool isFalseLoop(const Pose& measured, const Pose& truth, double max_m, double max_deg) {
+  const Pose e = truth.inverse() * measured;
+  return e.translation().norm() > max_m || Eigen::AngleAxisd(e.rotation()).angle() * 180.0 / M_PI > max_deg;
+}
+
+}  // namespace dlslot::eval

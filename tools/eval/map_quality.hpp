@@ -1,0 +1,60 @@
+// The static map's quality in the dynamic-map benchmark's terms (Zhang, Khoche, Lilja et al., "A
+// Dynamic Points Removal Benchmark in Point Cloud Maps", ITSC 2023: KTH DynamicMap_Benchmark),
+// counted on a voxel grid: the points of the keyframe scans the map was built from, placed with
+// the map's own keyframe poses, are labelled dynamic (inside the labelled box of an object whose
+// labelled track moves) or static (everything else); a voxel takes the label of the majority of
+// its points. SA is the share of static voxels the map keeps, DA the share of dynamic voxels it
+// does not hold, AA = sqrt(SA x DA).
+#pragma once
+
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "dlslot/types.hpp"
+
+namespace dlslot::eval {
+
+struct MapTruthOptions {
+  double voxel_m = 0.2;
+  double min_range_m = 2.5, max_range_m = 50.0;  // the mapper's range: points it never looked at are not scored
+  // A labelled track moves when its box centres, in the world, span more than this (box noise of
+  // labels is ~0.1-0.3 m; a parked car spans less, a car that drives off spans metres).
+  double moving_span_m = 1.0;
+  // The lowest band of a box is where its wheels meet the road: neither static nor dynamic, not scored.
+  double bottom_band_m = 0.1;
+  // Real KITTI labels cover what the camera sees: score only points in front of the camera within
+  // its horizontal field of view (set from the calibration; empty = all around, the simulator's labels).
+  std::optional<Pose> T_cam_lidar;
+  double camera_half_fov_rad = 0.0;
+};
+
+// One keyframe: its scan (lidar frame), its pose in the map, the labelled boxes of its scan.
+struct MapKeyframe {
+  int frame = 0;
+  PointCloud scan;
+  Pose T_map_lidar = Pose::Identity();
+  std::vector<Box> labels;  // lidar frame, id = labelled track id
+};
+
+struct MapScore {
+  double voxel_m = 0;
+  int64_t static_voxels = 0, dynamic_voxels = 0, static_kept = 0, dynamic_removed = 0;
+  std::optional<double> sa, da, aa;
+};
+
+// Track ids whose centres (labels of each frame put in the world with `poses`) span > moving_span_m.
+std::set<int> movingTracks(const std::map<int, std::vector<Box>>& labels_by_frame, const std::map<int, Pose>& poses,
+                           double moving_span_m);
+
+// map_points: the map's points (map frame, x y z columns).
+MapScore scoreMap(const PointCloud& map_points, const std::vector<MapKeyframe>& keyframes, const std::set<int>& moving,
+                  const MapTruthOptions& options);
+
+// An accepted loop is false when its relative pose is more than 1 m or 2 deg off the truth's.
+bool isFalseLoop(const Pose& measured_T_match_query, const Pose& truth_T_match_query, double max_m = 1.0,
+                 double max_deg = 2.0);
+
+}  // namespace dlslot::eval

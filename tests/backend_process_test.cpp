@@ -71,6 +71,8 @@ TEST(BackendProcess, LiveFramesWithMissingInputs) {
       lcm.publish("ODOMETRY", &o);
     }
     if (!in.associations_missing) {
+      const associations_t bad = malformedAssociationsMsg(in);  // refused whole, then the real one
+      lcm.publish("ASSOCIATIONS", &bad);
       const associations_t a = associationsMsg(in);
       lcm.publish("ASSOCIATIONS", &a);
     }
@@ -96,9 +98,10 @@ TEST(BackendProcess, LiveFramesWithMissingInputs) {
   EXPECT_EQ(st.last_frame, 13);
   EXPECT_EQ(st.timeouts, 2);
   EXPECT_EQ(st.decode_errors, 1);
-  EXPECT_GE(st.errors, 13);  // one malformed box per ASSOCIATIONS message
+  EXPECT_GE(st.errors, 13);  // one message with a malformed box per frame with ASSOCIATIONS
   std::map<std::string, int64_t> counters;
   for (int i = 0; i < st.num_counters; ++i) counters[st.counter_names[i]] = st.counter_values[i];
+  EXPECT_EQ(counters["refused.ASSOCIATIONS.non_finite"], 13);
   EXPECT_EQ(counters["odometry_missing"], 1);
   EXPECT_EQ(counters["associations_missing"], 1);
   EXPECT_GT(counters["last_iterations"], 0);

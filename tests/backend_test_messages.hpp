@@ -44,7 +44,14 @@ inline associations_t associationsMsg(const BackendInput& in) {
     as.confidence = obs.confidence;
     a.associations.push_back(as);
   }
-  // A malformed box (NaN size) must be skipped and counted, never be fatal.
+  a.num_associations = static_cast<int32_t>(a.associations.size());
+  return a;
+}
+
+// The same with a malformed box (NaN size) added: the guard refuses such a message whole
+// (message_guard.hpp), counted, never fatal.
+inline associations_t malformedAssociationsMsg(const BackendInput& in) {
+  associations_t a = associationsMsg(in);
   association_t bad{};
   bad.track_id = 999;
   bad.box_lidar.size[0] = std::nan("");

@@ -1,6 +1,6 @@
 // The message guard (common/include/dlslot/message_guard.hpp): its layout walk agrees with
 // lcm-gen's encoder byte for byte, every malformed variant is refused with the right
-// reason (never thrown, never allocated for), and FrameOrder's duplicate/old/jump/resync rules.
+// reason (never thrown, never allocated for), and FrameOrder's duplicate/old/jump rules (no resync).
 #include <gtest/gtest.h>
 
 #include "message_samples.hpp"
@@ -187,7 +187,7 @@ TEST(MessageGuard, WellFormedLiesAreRefused) {
   EXPECT_EQ(check<process_status_t>(encode(status)).reason, "bad_value");
 }
 
-TEST(MessageGuard, FrameOrderRefusesDuplicatesOldAndFarFramesAndResyncs) {
+TEST(MessageGuard, FrameOrderRefusesDuplicatesOldAndFarFramesAndNeverResyncs) {
   FrameOrder o;
   EXPECT_FALSE(o.accept(5));
   EXPECT_FALSE(o.accept(6));
@@ -198,12 +198,39 @@ TEST(MessageGuard, FrameOrderRefusesDuplicatesOldAndFarFramesAndResyncs) {
   EXPECT_EQ(o.accept(std::numeric_limits<int>::max()).reason, "frame_range");
   EXPECT_EQ(o.last(), 9);
   EXPECT_FALSE(o.accept(10));
-  // A stream that started again: three consecutive older frames make the channel follow it.
-  EXPECT_EQ(o.accept(0).reason, "old_frame");
-  EXPECT_EQ(o.accept(1).reason, "old_frame");
-  EXPECT_FALSE(o.accept(2));
-  EXPECT_EQ(o.last(), 2);
-  EXPECT_FALSE(o.accept(3));
-  // Repeated duplicates never resync.
-  for (int i = 0; i < 5; ++i) EXPECT_EQ(o.accept(3).reason, "duplicate_frame");
+  // Old frames in a row, however many, never make the channel follow them (replayed frames 0, 1,
+  // 2 once made it resync and reset the nodes)...
+  for (int f = 0; f < 10; ++f) EXPECT_EQ(o.accept(f).reason, "old_frame") << f;
+  // ...nor do far frames in a row (frames 2001-2004 once took over a channel at frame 12).
+  for (int f = 2001; f < 2010; ++f) EXPECT_EQ(o.accept(f).reason, "frame_jump") << f;
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(o.accept(10).reason, "duplicate_frame");
+  EXPECT_EQ(o.last(), 10);
+  EXPECT_FALSE(o.accept(11));
+  // Only an explicit restart (the player's start event) begins a new numbering.
+  o.reset();
+  EXPECT_FALSE(o.accept(0));
+  EXPECT_EQ(o.last(), 0);
+}
+
+TEST(MessageGuard, BoxesAreCheckedBeforeAnythingElseSeesThem) {
+  // A NaN box centre, a size <= 0: the whole DETECTIONS / ASSOCIATIONS message is refused.
+  detections_t det = sampleDetectionsWithBox(500);
+  det.boxes[0].center[0] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(check<detections_t>(encode(det)).reason, "non_finite");
+  det = sampleDetectionsWithBox(500);
+  det.boxes[0].size[1] = 0;
+  EXPECT_EQ(check<detections_t>(encode(det)).reason, "bad_size");
+  det = sampleDetectionsWithBox(500);
+  det.boxes[0].size[2] = -1;
+  EXPECT_EQ(check<detections_t>(encode(det)).reason, "bad_size");
+  det = sampleDetectionsWithBox(500);
+  det.boxes[0].score = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(check<detections_t>(encode(det)).reason, "non_finite");
+  EXPECT_FALSE(check<detections_t>(encode(sampleDetectionsWithBox(500))));
+  associations_t a = sampleAssociations(3);
+  a.associations[0].box_world.yaw = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(check<associations_t>(encode(a)).reason, "non_finite");
+  a = sampleAssociations(3);
+  a.associations[0].box_lidar.size[0] = 0;
+  EXPECT_EQ(check<associations_t>(encode(a)).reason, "bad_size");
 }

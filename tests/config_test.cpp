@@ -104,3 +104,31 @@ TEST(Config, AKeyThatIsNotANameIsAConfigError) {
     EXPECT_NE(e.find("expected a key name"), std::string::npos) << text << " -> " << e;
   }
 }
+
+// Two roles on one channel (channels.odometry: SLOT_STATE) once ran to exit 0 with no DL-SLOT
+// trajectory and no tracks: each channel needs a name of its own.
+TEST(Config, TwoChannelsWithOneNameAreRefusedNamingBoth) {
+  const std::string file = writeYaml("cfg_same_channel.yaml",
+                                     "channels: {scan: A, detections: B, ground_truth: C, odometry: F, associations: E,"
+                                     " slot_state: F, status: G}\n");
+  Channels c;
+  const std::string e = errorOf([&] { loadPipelineConfig(file, c); });
+  EXPECT_NE(e.find("channels.slot_state: channel 'F' is already channels.odometry"), std::string::npos) << e;
+  const std::string run_event = writeYaml("cfg_same_event.yaml",
+                                          "channels: {scan: A, detections: B, ground_truth: C, odometry: D, "
+                                          "associations: E, slot_state: F, status: G, run_event: A}\n");
+  const std::string e2 = errorOf([&] { loadPipelineConfig(run_event, c); });
+  EXPECT_NE(e2.find("channels.run_event: channel 'A' is already channels.scan"), std::string::npos) << e2;
+}
+
+// .nan parses as a YAML number; no setting means it.
+TEST(Config, NanIsRefusedNamingTheKey) {
+  for (const std::string v : {".nan", ".NaN"}) {
+    const std::string file = writeYaml("cfg_nan.yaml", "odometry:\n  margin: " + v + "\n  list: [1, " + v + "]\n");
+    ConfigSection s = loadConfig(file).section("odometry");
+    std::string e = errorOf([&] { s.get<double>("margin"); });
+    EXPECT_NE(e.find("odometry.margin (line 2): expected a number, got '" + v + "'"), std::string::npos) << e;
+    e = errorOf([&] { s.get<std::vector<double>>("list"); });
+    EXPECT_NE(e.find("odometry.list (line 3): expected a number, got a list with .nan"), std::string::npos) << e;
+  }
+}

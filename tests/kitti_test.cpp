@@ -105,6 +105,9 @@ TEST(KittiVelodyne, RoundTripAndBadFiles) {
 
   const std::string odd = tmpFile("odd.bin", std::string(20, '\0'));
   expectInputError([&] { readVelodyne(odd); }, {odd, "not a multiple of 16"});
+  // A 0-byte file is a scan cut off or never written, not a 0-point frame.
+  const std::string empty = tmpFile("empty.bin", "");
+  expectInputError([&] { readVelodyne(empty); }, {empty, "empty scan (0 bytes"});
   PointCloud bad = scan;
   bad(1, 2) = std::nanf("");
   const std::string nan_path = tmpFile("nan.bin", "");

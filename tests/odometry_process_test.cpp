@@ -135,10 +135,13 @@ TEST(OdometryProcess, FaultsDoNotStopIt) {
       det.utime = scan.utime;
       det.frame = f;
       det.boxes.push_back(toMsg(car));
-      if (f == 1) {
+      if (f == 1) {  // first a copy with a malformed box: refused whole by the guard
+        detections_t bad_det = det;
         box_t bad = toMsg(car);
         bad.size[2] = -1;
-        det.boxes.push_back(bad);
+        bad_det.boxes.push_back(bad);
+        bad_det.num_boxes = static_cast<int32_t>(bad_det.boxes.size());
+        lcm.publish("DETECTIONS", &bad_det);
       }
       det.num_boxes = static_cast<int32_t>(det.boxes.size());
       lcm.publish("DETECTIONS", &det);
@@ -167,5 +170,6 @@ TEST(OdometryProcess, FaultsDoNotStopIt) {
   EXPECT_GE(s.timeouts, 1);
   EXPECT_EQ(statusCounter(s, "unfiltered_frames"), 1);
   EXPECT_EQ(statusCounter(s, "fallback_frames"), 1);
-  EXPECT_EQ(statusCounter(s, "rejected_detections"), 1);
+  EXPECT_EQ(statusCounter(s, "refused.DETECTIONS.bad_size"), 1);
+  EXPECT_EQ(statusCounter(s, "rejected_detections"), 0);
 }

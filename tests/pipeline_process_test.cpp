@@ -173,7 +173,9 @@ TEST(PipelineProcess, ReplayedOdometryAndAssociationsGiveTheSameSlotState) {
 
   ChildProcess logger({"/usr/bin/lcm-logger", "--quiet", "--force", "--channel=SLOT_STATE", out + "/replay.lcmlog"},
                       out + "/logger.log");
-  ChildProcess backend({bin("dlslot-backend"), "--config", config(), "--mode", "slot"}, out + "/backend.log");
+  // The replay verifies with the run's key, which the run folder keeps (message_auth.hpp).
+  ChildProcess backend({bin("dlslot-backend"), "--config", config(), "--mode", "slot", "--key", out + "/run/run.key"},
+                       out + "/backend.log");
   std::this_thread::sleep_for(std::chrono::seconds(1));
   ChildProcess player({"/usr/bin/lcm-logplayer", "--speed=1", "--regexp=^(ODOMETRY|ASSOCIATIONS)$",
                        out + "/run/run.lcmlog"},
@@ -182,6 +184,8 @@ TEST(PipelineProcess, ReplayedOdometryAndAssociationsGiveTheSameSlotState) {
   std::this_thread::sleep_for(std::chrono::seconds(2));
   EXPECT_EQ(backend.stop(), 0) << backend.output();
   EXPECT_EQ(logger.stop(), 0);
+  EXPECT_NE(backend.output().find("messages authenticated with the run key"), std::string::npos) << backend.output();
+  EXPECT_EQ(backend.output().find("refused a message"), std::string::npos) << backend.output();
   const auto original = slotStatesOf(out + "/run/run.lcmlog"), replayed = slotStatesOf(out + "/replay.lcmlog");
   ASSERT_EQ(replayed.size(), original.size());
   for (size_t i = 0; i < original.size(); ++i) EXPECT_EQ(encoded(replayed[i]), encoded(original[i])) << "frame " << i;

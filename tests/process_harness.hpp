@@ -24,7 +24,9 @@
 #include <thread>
 #include <vector>
 
+#include "dlslot/lcm_log.hpp"
 #include "dlslot/message_guard.hpp"
+#include "dlslot/node.hpp"
 
 namespace dlslot::test {
 
@@ -156,12 +158,18 @@ inline bool handleUntil(lcm::LCM& lcm, const std::function<bool()>& pred, double
   return true;
 }
 
-// All events of an LCM log, grouped by channel, in log order.
+// All events of an LCM log, grouped by channel, in log order, their authentication envelopes
+// opened (verified with run.key beside the log when there is one; lcm_log.hpp); events that do
+// not verify are left out.
 inline std::map<std::string, std::vector<std::vector<uint8_t>>> readLog(const std::string& path) {
   std::map<std::string, std::vector<std::vector<uint8_t>>> out;
   lcm::LogFile log(path, "r");
   if (!log.good()) return out;
-  while (const lcm::LogEvent* ev = log.readNextEvent()) {
+  LogEnvelopes envelopes(path);
+  ProcessStatus refused("test");
+  while (const lcm::LogEvent* raw = log.readNextEvent()) {
+    const lcm::LogEvent* ev = envelopes.open(*raw, refused, path + ": ");
+    if (!ev) continue;
     const auto* d = static_cast<const uint8_t*>(ev->data);
     out[ev->channel].emplace_back(d, d + ev->datalen);
   }

@@ -1,5 +1,8 @@
 #include "dlslot/config.hpp"
 
+#include <iterator>
+
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -56,6 +59,15 @@ void ConfigSection::get(const std::string& key, T& out) {
       if (!n.IsSequence()) throw YAML::Exception(n.Mark(), "");
     }
     out = n.as<T>();
+    // .nan is a number to YAML but never a setting: refused like a misspelt key.
+    // (.inf is a limit that is not there, e.g. a speed bound a class does not have.)
+    bool number = true;
+    if constexpr (std::is_same_v<T, double>) number = !std::isnan(out);
+    if constexpr (std::is_same_v<T, std::vector<double>>)
+      for (double v : out) number = number && !std::isnan(v);
+    if (!number)
+      throw ConfigError(where(key) + " (line " + std::to_string(n.Mark().line + 1) +
+                        "): expected a number, got " + (n.IsScalar() ? "'" + n.Scalar() + "'" : "a list with .nan in it"));
   } catch (const YAML::Exception&) {
     std::string got = n.IsScalar() ? "'" + n.Scalar() + "'" : n.IsSequence() ? "a list" : "a map";
     throw ConfigError(where(key) + " (line " + std::to_string(n.Mark().line + 1) + "): expected " +
@@ -140,6 +152,19 @@ void Channels::read(ConfigSection s) {
   s.get("associations", associations);
   s.get("slot_state", slot_state);
   s.get("status", status);
+  if (s.has("run_event")) s.get("run_event", run_event);
+  const std::pair<const char*, const std::string*> all[] = {
+      {"scan", &scan},           {"detections", &detections}, {"ground_truth", &ground_truth},
+      {"odometry", &odometry},   {"associations", &associations}, {"slot_state", &slot_state},
+      {"status", &status},       {"run_event", &run_event}};
+  for (size_t i = 0; i < std::size(all); ++i) {
+    if (all[i].second->empty())
+      throw ConfigError(s.file() + ": " + s.path() + "." + all[i].first + ": expected a channel name, got ''");
+    for (size_t j = 0; j < i; ++j)
+      if (*all[i].second == *all[j].second)
+        throw ConfigError(s.file() + ": " + s.path() + "." + all[i].first + ": channel '" + *all[i].second +
+                          "' is already " + s.path() + "." + all[j].first + "; every channel needs a name of its own");
+  }
   s.finish();
 }
 

@@ -41,7 +41,9 @@ FrameAccounting accountFrames(const std::map<std::string, process_status_t>& las
   a.without_odometry = counter("backend", "odometry_missing");
   a.without_associations = counter("backend", "associations_missing");
   a.without_detections = std::max(counter("odometry", "unfiltered_frames"), counter("tracker", "detections_missing"));
-  for (const auto& [name, s] : last) a.kernel_drops += statusCounter(s, "udp_drops");
+  // Each process's own socket, plus what the launcher counted on the sockets of processes that do
+  // not report (lcm-logger's).
+  for (const auto& [name, s] : last) a.kernel_drops += statusCounter(s, "udp_drops") + statusCounter(s, "udp_drops_elsewhere");
   return a;
 }
 

@@ -211,6 +211,9 @@ PointCloud readVelodyne(const std::string& path) {
 }
 
 PointCloud readVelodyne(const char* data, size_t bytes, const std::string& path) {
+  // A lidar sweep without a single return is a file that was cut off or never written (a full
+  // disk, a copy interrupted), not a scene: played, it would be a silent 0-point frame.
+  if (bytes == 0) throw InputError(path, 0, "empty scan (0 bytes; expected float32 x y z reflectance per point)");
   if (bytes % 16 != 0)
     throw InputError(path, 0, "size " + std::to_string(bytes) +
                                   " bytes is not a multiple of 16 (expected float32 x y z reflectance per point)");
@@ -618,14 +621,22 @@ SequencePaths locateSequence(const std::string& root, const std::string& sequenc
   if (!fs::exists(p.calib)) throw InputError(p.calib, 0, "calibration file missing");
   if (p.velodyne_dir.empty()) return p;  // no scans: SequenceReader counts frames from labels and detections
   int n = 0;
-  for (const auto& e : fs::directory_iterator(p.velodyne_dir))
-    if (e.path().extension() == ".bin") ++n;
+  long highest = -1;  // the highest-numbered scan there: where the sequence ends
+  for (const auto& e : fs::directory_iterator(p.velodyne_dir)) {
+    if (e.path().extension() != ".bin") continue;
+    ++n;
+    const std::string stem = e.path().stem().string();
+    char* end = nullptr;
+    const long i = std::strtol(stem.c_str(), &end, 10);
+    if (!stem.empty() && end && *end == '\0') highest = std::max(highest, i);
+  }
   for (int i = 0; i < n; ++i) {
-    char name[32];
+    char name[32], last[32];
     std::snprintf(name, sizeof name, "%06d.bin", i);
+    std::snprintf(last, sizeof last, "%06ld.bin", std::max<long>(highest, n - 1));
     if (!fs::exists(fs::path(p.velodyne_dir) / name))
-      throw InputError(p.velodyne_dir, 0, "expected scans 000000.bin .. " + std::to_string(n - 1) +
-                                              ".bin without gaps; missing " + name);
+      throw InputError(p.velodyne_dir, 0, std::string("expected scans 000000.bin .. ") + last +
+                                              " without gaps; missing " + name);
   }
   if (n == 0) throw InputError(p.velodyne_dir, 0, "no .bin scans");
   p.num_frames = n;

@@ -2,10 +2,15 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 
+#include <cstdlib>
+#include <filesystem>
+
 #include "dlslot/input_error.hpp"
+#include "dlslot/node.hpp"
 
 namespace dlslot {
 namespace {
@@ -48,6 +53,34 @@ const lcm::LogEvent* nextLogEvent(lcm::LogFile& log, const std::string& path) {
   const lcm::LogEvent* event = log.readNextEvent();
   if (!event) throw InputError(path, 0, "corrupt log: no event follows the one" + where);
   return event;
+}
+
+LogEnvelopes::LogEnvelopes(const std::string& log_path) {
+  if (const char* env = std::getenv(kKeyFileEnv); env && *env) {
+    key_path_ = env;
+  } else {
+    const std::filesystem::path beside = std::filesystem::path(log_path).parent_path() / kRunKeyFile;
+    if (std::filesystem::exists(beside)) key_path_ = beside.string();
+  }
+  if (!key_path_.empty()) auth_ = MessageAuth(readKeyFile(key_path_));
+}
+
+const lcm::LogEvent* LogEnvelopes::open(const lcm::LogEvent& ev, ProcessStatus& status, const std::string& where) {
+  // LCM's own self-test message, which every LCM instance (the logger's too) sends to itself when
+  // it starts: not the pipeline's, read by nobody, so neither verified nor counted.
+  if (ev.channel == "LCM_SELF_TEST") return &ev;
+  const uint8_t* payload = nullptr;
+  size_t size = 0;
+  if (const Refusal why = auth_.open(ev.channel, ev.data, static_cast<size_t>(std::max(ev.datalen, 0)), &payload, &size)) {
+    status.refused(ev.channel, why, where);
+    return nullptr;
+  }
+  event_.eventnum = ev.eventnum;
+  event_.timestamp = ev.timestamp;
+  event_.channel = ev.channel;
+  event_.datalen = static_cast<int32_t>(size);
+  event_.data = const_cast<uint8_t*>(payload);
+  return &event_;
 }
 
 }  // namespace dlslot

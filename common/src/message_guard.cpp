@@ -202,6 +202,10 @@ Refusal checkLabelBox(const box_t& b, const std::string& field, bool allow_empty
   return {};
 }
 
+// A detected box (DETECTIONS, the boxes of ASSOCIATIONS): finite, every size > 0 (a detector
+// finds no object without extent), a track id >= -1.
+Refusal checkDetectedBox(const box_t& b, const std::string& field) { return checkLabelBox(b, field, false); }
+
 Refusal checkStatus(int8_t status, int max, const std::string& field) {
   if (status < 0 || status > max)
     return {"bad_enum", field + " = " + std::to_string(status) + ", expected 0.." + std::to_string(max)};
@@ -278,6 +282,13 @@ Refusal checkLayout(const process_status_t*, const void* data, size_t size) {
   return c.finish();
 }
 
+Refusal checkLayout(const run_event_t*, const void* data, size_t size) {
+  Cursor c(data, size);
+  (void)(c.fingerprint(run_event_t::getHash()) && c.skip(kI64, "utime") && c.str("event") &&
+         c.skip(kI32, "first_frame") && c.str("sequence"));
+  return c.finish();
+}
+
 // ---------------- contents ----------------
 
 Refusal checkContent(const point_cloud_t& m) {
@@ -295,7 +306,9 @@ Refusal checkContent(const point_cloud_t& m) {
 Refusal checkContent(const detections_t& m) {
   if (Refusal r = checkFrame(m.frame)) return r;
   if (Refusal r = checkUtime(m.utime)) return r;
-  return checkTimings(m.timings);  // boxes: refused one by one by the consumers (rejected_detections)
+  for (size_t i = 0; i < m.boxes.size(); ++i)
+    if (Refusal r = checkDetectedBox(m.boxes[i], fieldAt("boxes", i))) return r;
+  return checkTimings(m.timings);
 }
 
 Refusal checkContent(const ground_truth_t& m) {
@@ -340,6 +353,8 @@ Refusal checkContent(const associations_t& m) {
     if (Refusal r = checkNonNegative(a.detection_index, "associations.detection_index")) return r;
     if (Refusal r = checkNonNegative(a.track_id, "associations.track_id")) return r;
     if (Refusal r = checkNonNegative(a.num_observations, "associations.num_observations")) return r;
+    if (Refusal r = checkDetectedBox(a.box_lidar, f + ".box_lidar")) return r;
+    if (Refusal r = checkDetectedBox(a.box_world, f + ".box_world")) return r;
     if (a.has_prediction)
       if (Refusal r = checkFinite(a.predicted, 3, f + ".predicted")) return r;
     if (!std::isfinite(a.displacement)) return nonFinite(f + ".displacement");
@@ -399,44 +414,35 @@ Refusal checkContent(const process_status_t& m) {
                                                     {m.errors, "errors"}};
   for (const auto& [v, name] : counts)
     if (Refusal r = checkNonNegative(v, name)) return r;
+  // Every counter counts something (frames, messages, bytes): a negative one would turn the
+  // frame accounting's sums around.
+  for (size_t i = 0; i < m.counter_values.size(); ++i)
+    if (m.counter_values[i] < 0)
+      return {"bad_value", "counter " + m.counter_names[i] + " = " + std::to_string(m.counter_values[i]) +
+                               ", expected >= 0"};
   return {};
+}
+
+Refusal checkContent(const run_event_t& m) {
+  if (Refusal r = checkUtime(m.utime)) return r;
+  if (m.event != "start") return {"bad_enum", "event = '" + m.event + "', expected 'start'"};
+  return checkFrame(m.first_frame, "first_frame");
 }
 
 // ---------------- frame order ----------------
 
 Refusal FrameOrder::accept(int frame) {
   if (Refusal r = checkFrame(frame)) return r;  // callers check content first; kept for direct use
-  Refusal r;
-  if (last_ < 0) {
-    last_ = frame;
-    run_length_ = 0;
-    return {};
+  if (last_ >= 0) {
+    if (frame == last_) return {"duplicate_frame", "frame " + std::to_string(frame) + " again"};
+    if (frame < last_)
+      return {"old_frame", "frame " + std::to_string(frame) + " after frame " + std::to_string(last_)};
+    if (frame - last_ > kMaxFrameJump)
+      return {"frame_jump", "frame " + std::to_string(frame) + " after frame " + std::to_string(last_) +
+                                ", expected at most " + std::to_string(kMaxFrameJump) + " ahead"};
   }
-  if (frame == last_)
-    r = {"duplicate_frame", "frame " + std::to_string(frame) + " again"};
-  else if (frame < last_)
-    r = {"old_frame", "frame " + std::to_string(frame) + " after frame " + std::to_string(last_)};
-  else if (frame - last_ > kMaxFrameJump)
-    r = {"frame_jump", "frame " + std::to_string(frame) + " after frame " + std::to_string(last_) + ", expected at most " +
-                           std::to_string(kMaxFrameJump) + " ahead"};
-  if (!r) {
-    last_ = frame;
-    run_length_ = 0;
-    return {};
-  }
-  // A refused frame that continues the previous refused one: the stream may really have moved.
-  if (r.reason != "duplicate_frame" && run_length_ > 0 && frame == run_start_ + run_length_)
-    ++run_length_;
-  else if (r.reason != "duplicate_frame") {
-    run_start_ = frame;
-    run_length_ = 1;
-  }
-  if (run_length_ >= kFrameResync) {
-    last_ = frame;
-    run_length_ = 0;
-    return {};
-  }
-  return r;
+  last_ = frame;
+  return {};
 }
 
 }  // namespace dlslot

@@ -5,11 +5,13 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cmath>
 #include <atomic>
+#include <cmath>
+#include <filesystem>
 #include <csignal>
 #include <cstdlib>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <set>
 #include <sstream>
@@ -48,6 +50,9 @@ void CommandLine::option(const std::string& name, double* value, const std::stri
                      }
                      if (used != v.size() || v.empty())
                        throw std::invalid_argument(name + ": expected a number, got '" + v + "'");
+                     // nan and inf parse, but no option means them (--speed nan once meant lockstep).
+                     if (!std::isfinite(*value))
+                       throw std::invalid_argument(name + ": expected a finite number, got '" + v + "'");
                    }});
 }
 
@@ -65,6 +70,13 @@ void CommandLine::option(const std::string& name, int* value, const std::string&
 
 void CommandLine::repeated(const std::string& name, std::vector<std::string>* values, const std::string& help) {
   opts_.push_back({name, help + " (repeatable)", [values](const std::string& v) { values->push_back(v); }});
+}
+
+void CommandLine::action(const std::string& name, std::function<void(const std::string&)> apply,
+                         const std::string& help, bool takes_value) {
+  Opt o{name, help, std::move(apply)};
+  o.is_flag = !takes_value;
+  opts_.push_back(o);
 }
 
 void CommandLine::flag(const std::string& name, bool* value, const std::string& help) {
@@ -113,7 +125,19 @@ void NodeOptions::addTo(CommandLine& cl) {
   cl.option("--config", &config, "YAML config file (default config/dlslot.yaml)");
   cl.option("--lcm-url", &lcm_url, "LCM URL (default: $LCM_DEFAULT_URL or LCM's default)");
   cl.flag("--check-config", &check_config, "load and validate the config, then exit");
+  cl.action("--key", useKeyFile,
+            "key file authenticating this run's messages (default: $DLSLOT_KEY_FILE; the launcher makes one)");
+  cl.action("--insecure", [](const std::string&) { useNoKey(); }, "no message authentication (open LCM)", false);
 }
+
+void useKeyFile(const std::string& path) {
+  if (path.empty()) throw std::invalid_argument("--key: expected a key file");
+  const std::string abs = std::filesystem::absolute(path).string();
+  readKeyFile(abs);  // refused now, naming the file, rather than in every process
+  setenv(kKeyFileEnv, abs.c_str(), 1);
+}
+
+void useNoKey() { unsetenv(kKeyFileEnv); }
 
 // ---------------- ProcessStatus ----------------
 
@@ -269,6 +293,15 @@ bool signalReceived() { return g_signal; }
 
 Node::Node(std::string name, const std::string& lcm_url, const Channels& channels)
     : name_(std::move(name)), lcm_(lcm_url), channels_(channels), status_(name_) {
+  if (std::optional<RunKey> key = keyFromEnvironment()) {
+    auth_ = MessageAuth(*key);
+    std::fprintf(stderr, "[%s] messages authenticated with the run key %s (run %s)\n", name_.c_str(),
+                 std::getenv(kKeyFileEnv), key->runIdHex().c_str());
+  } else {
+    std::fprintf(stderr, "[%s] no run key (--key FILE or $%s): messages are neither signed nor verified\n",
+                 name_.c_str(), kKeyFileEnv);
+  }
+  status_.set("authenticated", auth_.enabled() ? 1 : 0);
   if (!lcm_.good())
     throw std::runtime_error("cannot initialise LCM with URL '" +
                              (lcm_url.empty() ? std::string("(default)") : lcm_url) + "'");
@@ -292,10 +325,34 @@ Node::Node(std::string name, const std::string& lcm_url, const Channels& channel
     // No subscription yet, so no point cloud is wanted until one subscribes to the scan channel.
     filtering_large_ = attachLargeMessageFilter(recv_fd_);
   }
+  // The player's start events, for every node (handleRunEvent).
+  subscribe<run_event_t>(channels_.run_event, [this](const run_event_t& e) { handleRunEvent(e); });
 }
 
 void Node::noteSubscription(const std::string& channel) {
   if (channel == channels_.scan && filtering_large_) filtering_large_ = !detachLargeMessageFilter(recv_fd_);
+}
+
+void Node::handleRunEvent(const run_event_t& e) {
+  bool started = !frames_received_.empty();
+  for (const auto& [channel, order] : frame_order_) started = started || order.last() >= 0;
+  if (!started) return;  // the first start of the run: nothing to forget
+  status_.count("restarts");
+  status_.warn("the player started again (sequence " + e.sequence + " from frame " + std::to_string(e.first_frame) +
+               "): starting over");
+  for (auto& [channel, order] : frame_order_) order.reset();
+  frames_received_.clear();
+  for (const auto& cb : restart_handlers_) cb(e);
+}
+
+void Node::publishStart(int first_frame, const std::string& sequence) {
+  run_event_t e;
+  e.utime = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+                .count();
+  e.event = "start";
+  e.first_frame = first_frame;
+  e.sequence = sequence;
+  publish(channels_.run_event, e);
 }
 
 void Node::noteFrameReceived(int frame) {
@@ -309,17 +366,49 @@ void Node::checkSize(const std::string& channel, int64_t bytes) {
                   std::to_string(kLargeMessageBytes) + " bytes or more (large_message_filter.hpp)");
 }
 
-void Node::publishEncoded(const std::string& channel, const void* data, size_t size) {
-  if (channel != channels_.scan) checkSize(channel, static_cast<int64_t>(size));
-  if (lcm_.publish(channel, data, static_cast<unsigned>(size)) != 0) status_.error("publish on " + channel + " failed");
-}
-
 void Node::subscribeRaw(const std::string& channel, RawHandler cb) {
   noteSubscription(channel);
-  handlers_.push_back(std::move(cb));
-  lcm_.subscribeFunction<RawHandler*>(
-      channel, [](const lcm::ReceiveBuffer* rbuf, const std::string&, RawHandler* h) { (*h)(*rbuf); },
+  for (ChannelHandlers& h : handlers_)
+    if (h.channel == channel) {
+      h.handlers.push_back(std::move(cb));
+      return;
+    }
+  handlers_.push_back({this, channel, {std::move(cb)}});
+  lcm_.subscribeFunction<ChannelHandlers*>(
+      channel,
+      [](const lcm::ReceiveBuffer* rbuf, const std::string&, ChannelHandlers* h) { h->node->dispatch(h->channel, *rbuf); },
       &handlers_.back());
+}
+
+void Node::dispatch(const std::string& channel, const lcm::ReceiveBuffer& rbuf) {
+  // The envelope first: nothing unauthenticated reaches a decoder or any state.
+  const uint8_t* payload = nullptr;
+  size_t size = 0;
+  if (const Refusal why = auth_.open(channel, rbuf.data, rbuf.data_size, &payload, &size)) {
+    status_.refused(channel, why);
+    return;
+  }
+  lcm::ReceiveBuffer inner = rbuf;
+  inner.data = const_cast<uint8_t*>(payload);
+  inner.data_size = static_cast<uint32_t>(size);
+  for (ChannelHandlers& h : handlers_)
+    if (h.channel == channel) {
+      for (size_t i = 0; i < h.handlers.size(); ++i) h.handlers[i](inner);
+      return;
+    }
+}
+
+void Node::publishSealed(const std::string& channel, size_t payload_size) {
+  auth_.seal(channel, out_buf_.data(), payload_size);
+  if (lcm_.publish(channel, out_buf_.data(), static_cast<unsigned>(out_buf_.size())) != 0)
+    status_.error("publish on " + channel + " failed");
+}
+
+void Node::publishEncoded(const std::string& channel, const void* data, size_t size) {
+  if (channel != channels_.scan) checkSize(channel, static_cast<int64_t>(size));
+  out_buf_.resize(auth_.headerBytes() + size + auth_.tagBytes());
+  if (size) std::memcpy(out_buf_.data() + auth_.headerBytes(), data, size);
+  publishSealed(channel, size);
 }
 
 void Node::every(double period_s, std::function<void()> cb) {

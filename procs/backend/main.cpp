@@ -122,7 +122,10 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   const bool use_scans = !config.registration_types.empty() && config.mode != Mode::kOdometryOnly;
   std::optional<std::pair<int, PointCloud>> scan;
   std::map<std::string, FrameOrder> scan_order;
-  for (; const lcm::LogEvent* ev = nextLogEvent(in, in_path); ++index) {
+  LogEnvelopes envelopes(in_path);  // every event verified as it would be live (lcm_log.hpp)
+  for (; const lcm::LogEvent* raw = nextLogEvent(in, in_path); ++index) {
+    const lcm::LogEvent* ev = envelopes.open(*raw, guard, in_path + ": event " + std::to_string(index) + ": ");
+    if (!ev) continue;
     if (use_scans && ev->channel == channels.scan) {
       point_cloud_t m;
       Refusal why = decodeChecked(ev->data, static_cast<size_t>(std::max(ev->datalen, 0)), &m);
@@ -180,13 +183,22 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
     lcm::LogFile again(in_path, "r");
     int64_t n = 0;
     std::vector<uint8_t> buf;
+    // Events that did not verify are left out; the rest are sealed again with the run's key (when
+    // there is one), so the output verifies like the input.
+    LogEnvelopes reopen(in_path);
+    ProcessStatus refused_again("backend");
+    MessageAuth sealer = reopen.auth().enabled() ? MessageAuth(*reopen.auth().key()) : MessageAuth();
     auto write = [&](const lcm::LogEvent& ev) {
       lcm::LogEvent copy = ev;
+      const std::vector<uint8_t> sealed = sealer.sealCopy(ev.channel, ev.data, static_cast<size_t>(ev.datalen));
+      copy.data = const_cast<uint8_t*>(sealed.data());
+      copy.datalen = static_cast<int32_t>(sealed.size());
       copy.eventnum = n++;
       if (out.writeEvent(&copy) != 0) throw std::runtime_error(out_path + ": write failed");
     };
-    for (int64_t i = 0; const lcm::LogEvent* ev = nextLogEvent(again, in_path); ++i) {
-      if (ev->channel == channels.slot_state) continue;
+    for (int64_t i = 0; const lcm::LogEvent* raw = nextLogEvent(again, in_path); ++i) {
+      const lcm::LogEvent* ev = reopen.open(*raw, refused_again, "");
+      if (!ev || ev->channel == channels.slot_state) continue;
       write(*ev);
       const auto input = accepted.find(i);
       const int frame = input == accepted.end() ? -1 : input->second;

@@ -3,6 +3,7 @@
 // player publishes from detection files, made from the scan itself, so DL-SLOT runs on any log.
 // With --kitti: the same detector offline over a sequence's files, with --eval recall and
 // precision per class against its labels, with --write-detections a KITTI detection file.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -43,6 +44,12 @@ int runNode(const NodeOptions& node_opts, const Channels& channels, const Detect
       status.error("frame " + std::to_string(msg.frame) + ": " + e.what() + "; published without boxes");
       out.boxes.clear();
     }
+    // Receivers refuse a DETECTIONS message with a degenerate box whole (message_guard.hpp): a
+    // cluster measured flat in some direction is left out here, counted, not sent.
+    const size_t before = out.boxes.size();
+    out.boxes.erase(std::remove_if(out.boxes.begin(), out.boxes.end(), [](const box_t& b) { return !isValid(b); }),
+                    out.boxes.end());
+    if (out.boxes.size() != before) status.count("degenerate_boxes", static_cast<int64_t>(before - out.boxes.size()));
     out.num_boxes = static_cast<int32_t>(out.boxes.size());
     // "total" is the whole callback (conversion included), as the other processes report it.
     const double total_ms = std::chrono::duration<double, std::milli>(Node::Clock::now() - tic).count();

@@ -102,17 +102,14 @@ int runNode(const NodeOptions& node_opts, const Channels& channels, const Odomet
       process(*joined.a, joined.b.has_value());
     }
   };
-  // A scan older than one already handled: the input restarted (a new run). Start over.
-  auto restartIfRewound = [&](int frame) {
-    if (frame >= joiner.lastReleased()) return;
-    status.warn("frame " + std::to_string(frame) + " after frame " + std::to_string(joiner.lastReleased()) +
-                ": input restarted, odometry reset");
+  // The player's explicit start event (Node::onRestart) is the only thing that starts it over:
+  // an old or repeated frame is refused before it gets here.
+  node.onRestart([&](const run_event_t&) {
     joiner.reset();
     odometry.reset();
-  };
+  });
 
   node.subscribeFrames<point_cloud_t>(channels.scan, [&](const point_cloud_t& msg) {
-    restartIfRewound(msg.frame);
     Frame frame;
     frame.index = msg.frame;
     frame.utime = msg.utime;
@@ -121,7 +118,6 @@ int runNode(const NodeOptions& node_opts, const Channels& channels, const Odomet
     releaseReady();
   });
   node.subscribeFrames<detections_t>(channels.detections, [&](const detections_t& msg) {
-    if (msg.frame == 0) restartIfRewound(0);  // a restarted player may send DETECTIONS 0 first
     std::vector<Box> boxes;
     int rejected = 0;
     for (const box_t& b : msg.boxes) {

@@ -32,6 +32,13 @@ struct PlayerConfig {
     s.get("min_detection_score", min_detection_score);
     s.get("lockstep_timeout_s", lockstep_timeout_s);
     s.get("frame_period_s", frame_period_s);
+    // A wait and a period are durations: <= 0 would release every frame at once (frames lost).
+    if (!(lockstep_timeout_s > 0))
+      throw ConfigError(s.file() + ": " + s.path() + ".lockstep_timeout_s: expected > 0 s, got " +
+                        std::to_string(lockstep_timeout_s));
+    if (!(frame_period_s > 0))
+      throw ConfigError(s.file() + ": " + s.path() + ".frame_period_s: expected > 0 s, got " +
+                        std::to_string(frame_period_s));
     s.finish();
   }
 };
@@ -119,6 +126,8 @@ int run(int argc, char** argv) {
     });
 
   node.spinUntil([] { return false; }, delay_s);
+  // The explicit start (RUN_EVENT): nodes that handled frames of an earlier play start over.
+  node.publishStart(range.start, sequence);
   const int total = range.end - range.start + 1;
   ProgressLine progress("play " + sequence, total);
   std::optional<player::RatePacer> pacer;

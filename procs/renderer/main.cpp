@@ -86,7 +86,10 @@ int renderLog(const std::string& log_path, const std::string& out, const Rendere
   FrameWriter writer(out, cfg);
   FrameSink sink(writer, status, false);
   ProgressLine progress("render", scans);
-  while (const lcm::LogEvent* e = nextLogEvent(log, log_path)) {
+  LogEnvelopes envelopes(log_path);
+  for (int64_t index = 0; const lcm::LogEvent* raw = nextLogEvent(log, log_path); ++index) {
+    const lcm::LogEvent* e = envelopes.open(*raw, status, log_path + ": event " + std::to_string(index) + ": ");
+    if (!e) continue;
     feed.handle(e->channel, e->data, e->datalen);
     sink.draw(state.takeReady());
     progress.update(sink.written());

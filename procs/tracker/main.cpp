@@ -216,18 +216,16 @@ int run(int argc, char** argv) {
       status.count("slot_state_missing", without);
     }
   };
-  // A frame 0 after later frames: the player started again. Start from scratch.
-  auto restartIfRewound = [&](int frame) {
-    if (frame != 0 || joiner.lastReleased() < 0) return;
-    status.warn("frame 0 after frame " + std::to_string(joiner.lastReleased()) + ": input restarted, tracker reset");
+  // The player's explicit start event (Node::onRestart) is the only thing that starts it over:
+  // an old or repeated frame is refused before it gets here.
+  node.onRestart([&](const run_event_t&) {
     associator.reset();
     joiner.reset();
     gate.reset();
     ego_poses = EgoPoseChain();
-  };
+  });
 
   node.subscribeFrames<detections_t>(channels.detections, [&](const detections_t& msg) {
-    restartIfRewound(msg.frame);
     DetectionFrame d = toDetectionFrame(msg);
     if (d.num_rejected > 0) {
       status.error(channels.detections + " frame " + std::to_string(msg.frame) + ": " +
@@ -238,7 +236,6 @@ int run(int argc, char** argv) {
     releaseReady();
   });
   node.subscribeFrames<odometry_t>(channels.odometry, [&](const odometry_t& msg) {
-    restartIfRewound(msg.frame);
     if (!joiner.addB(msg.frame, msg.utime, secondsNow())) {
       status.count("stale_messages");
       return;

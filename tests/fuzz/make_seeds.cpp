@@ -11,7 +11,9 @@
 #include <vector>
 
 #include "dlslot/config.hpp"
+#include "dlslot/lcm_log.hpp"
 #include "dlslot/message_guard.hpp"
+#include "dlslot/node.hpp"
 
 using namespace dlslot;
 namespace fs = std::filesystem;
@@ -47,11 +49,15 @@ int main(int argc, char** argv) {
   const std::map<std::string, std::string> target = {
       {ch.scan, "point_cloud_t"},   {ch.detections, "detections_t"},     {ch.ground_truth, "ground_truth_t"},
       {ch.odometry, "odometry_t"},  {ch.associations, "associations_t"}, {ch.slot_state, "slot_state_t"},
-      {ch.status, "process_status_t"}};
+      {ch.status, "process_status_t"}, {ch.run_event, "run_event_t"}};
   std::map<std::string, int> written;
   lcm::LogFile log((dir / "fuzz_file_run_log" / "run.lcmlog").string(), "w");
   int64_t n = 0;
-  while (const lcm::LogEvent* ev = in.readNextEvent()) {
+  LogEnvelopes envelopes(argv[1]);  // a run's log holds authenticated envelopes: their messages are the seeds
+  ProcessStatus refused("make_seeds");
+  while (const lcm::LogEvent* raw = in.readNextEvent()) {
+    const lcm::LogEvent* ev = envelopes.open(*raw, refused, "");
+    if (!ev) continue;
     const auto t = target.find(ev->channel);
     if (t == target.end() || written[t->second] >= 2) continue;
     Bytes b;
@@ -62,6 +68,7 @@ int main(int argc, char** argv) {
                     : type == "odometry_t"       ? accepted<odometry_t>(*ev, &b)
                     : type == "associations_t"   ? accepted<associations_t>(*ev, &b)
                     : type == "slot_state_t"     ? accepted<slot_state_t>(*ev, &b)
+                    : type == "run_event_t"      ? accepted<run_event_t>(*ev, &b)
                                                  : accepted<process_status_t>(*ev, &b);
     if (!ok) continue;
     const fs::path out = dir / ("fuzz_msg_" + type) / ("sim-" + std::to_string(written[type]++));

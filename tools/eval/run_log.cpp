@@ -65,8 +65,14 @@ class LogReader {
       run_.frame_counts[*c] = 0;
     // nextLogEvent (lcm_log.hpp) refuses truncated and corrupt logs, garbage between events and
     // headers that claim more than the file holds, before LCM allocates.
+    // Each event's authentication envelope is checked as a live node would (lcm_log.hpp).
+    LogEnvelopes envelopes(path_);
     int64_t count = 0;
-    while (const lcm::LogEvent* ev = nextLogEvent(log, path_)) handle(*ev, count++);
+    while (const lcm::LogEvent* raw = nextLogEvent(log, path_)) {
+      const int64_t index = count++;
+      if (const lcm::LogEvent* ev = envelopes.open(*raw, refusals_, path_ + ": event " + std::to_string(index) + ": "))
+        handle(*ev, index);
+    }
     if (count == 0) throw InputError(path_, 0, "the log holds no events");
     finishSlot();
     run_.refused = refusals_.refusals();

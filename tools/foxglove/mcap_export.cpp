@@ -10,6 +10,7 @@
 #include "dlslot/cpu_clock.hpp"
 #include "dlslot/input_error.hpp"
 #include "dlslot/lcm_log.hpp"
+#include "dlslot/node.hpp"
 #include "foxglove_convert.hpp"
 #include "mcap_writer.hpp"
 
@@ -32,8 +33,14 @@ ExportStats exportMcap(const std::string& log_path, const std::string& mcap_path
   std::unordered_map<int64_t, uint64_t> scan_time;  // utime -> log_time (ns) of its first message
   std::vector<Output> out;
   int64_t since_progress = 0;
-  while (const lcm::LogEvent* ev = nextLogEvent(log, log_path)) {
+  // Each event's authentication envelope is checked as a live node would (lcm_log.hpp); what does
+  // not verify is counted below with the other refusals.
+  LogEnvelopes envelopes(log_path);
+  ProcessStatus unverified("export");
+  while (const lcm::LogEvent* raw = nextLogEvent(log, log_path)) {
     ++stats.events;
+    const lcm::LogEvent* ev = envelopes.open(*raw, unverified, log_path + ": ");
+    if (!ev) continue;
     const std::string channel = ev->channel;
     if (channel == channels.scan) ++stats.scans;
     out.clear();
@@ -60,6 +67,10 @@ ExportStats exportMcap(const std::string& log_path, const std::string& mcap_path
       since_progress = 0;
       progress(static_cast<int64_t>(std::ftell(log.getFilePtr())), static_cast<int64_t>(st.st_size));
     }
+  }
+  for (const auto& [key, n] : unverified.refusals()) {  // "CHANNEL.REASON"
+    const size_t dot = key.rfind('.');
+    stats.refused[key.substr(0, dot) + ": " + key.substr(dot + 1)] += n;
   }
   writer.close();
   stats.bytes = static_cast<int64_t>(writer.bytesWritten());

@@ -21,12 +21,14 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <yaml-cpp/yaml.h>
 
 #include "dlslot/input_error.hpp"
 
 #include "dlslot/frame_accounting.hpp"
 #include "dlslot/kitti.hpp"
+#include "dlslot/message_auth.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/process_status_t.hpp"
 #include "dlslot/progress.hpp"
@@ -170,9 +172,11 @@ int runPipeline(int argc, char** argv) {
   std::string input, sensor_calib;
   std::string root, sequence = "0000", scenario, mode = "slot", config = "config/dlslot.yaml", out, lcm_url, detector;
   std::vector<std::string> detections;
-  int frames = -1, seed = 1, in_flight = 2;
-  double speed = 0, stall_s = 60, start_timeout_s = 30, heartbeat_s = 10;
-  bool no_eval = false, no_render = false, no_map = false, quiet = false, allow_loss = false;
+  constexpr int kNotGiven = std::numeric_limits<int>::min();
+  int frames = kNotGiven, seed = 1, in_flight = 2;
+  double speed = std::numeric_limits<double>::quiet_NaN(), stall_s = 60, start_timeout_s = 30, heartbeat_s = 10;
+  bool no_eval = false, no_render = false, no_map = false, quiet = false, allow_loss = false, insecure = false;
+  std::string key_file, make_key;
   CommandLine cl("dlslot-run", "Runs player, odometry, tracker, backend, renderer and lcm-logger on one sequence.");
   cl.option("--kitti", &root, "KITTI root (holding training/ or sequences/)");
   cl.option("--sequence", &sequence, "sequence (default 0000)");
@@ -183,13 +187,13 @@ int runPipeline(int argc, char** argv) {
   cl.option("--scenario", &scenario, "simulate this scenario (name or YAML) first, then run on it");
   cl.option("--input", &input, "a folder of your own .pcd or .bin scans with times.txt (docs/data-formats.md)");
   cl.option("--calib", &sensor_calib, "with --input: the sensor's YAML calibration");
-  cl.option("--frames", &frames, "frames to simulate (with --scenario) or to play (default: all)");
+  cl.option("--frames", &frames, "frames to simulate (with --scenario) or to play, >= 1 (default: all)");
   cl.option("--seed", &seed, "simulator seed (default 1)");
   cl.option("--mode", &mode, "slot | aloam | aloam-filtered | two-stage (default slot)");
   cl.option("--config", &config, "YAML config (default config/dlslot.yaml)");
   cl.option("--out", &out, "output directory");
   cl.option("--lcm-url", &lcm_url, "LCM URL for every process (default: $LCM_DEFAULT_URL)");
-  cl.option("--speed", &speed, "rate mode at this real-time factor instead of lockstep");
+  cl.option("--speed", &speed, "rate mode at this real-time factor (> 0) instead of lockstep");
   cl.option("--stall-timeout", &stall_s, "seconds without progress before the run fails (default 60)");
   cl.option("--heartbeat-timeout", &heartbeat_s,
             "seconds without a process's PROCESS_STATUS before it counts as stalled and the run fails (default 10)");
@@ -201,10 +205,41 @@ int runPipeline(int argc, char** argv) {
   cl.flag("--no-render", &no_render, "do not start the renderer");
   cl.flag("--no-map", &no_map, "do not start the mapper (no map.pcd, map.png, trajectory_map_*)");
   cl.flag("--quiet", &quiet, "no progress line");
+  cl.option("--key", &key_file,
+            "authenticate the run's messages with this key file (0600; the same file on every machine of the run); "
+            "default: a fresh key per run, kept as run.key in --out");
+  cl.flag("--insecure", &insecure, "no message authentication: any host on the LCM URL can publish into the run");
+  cl.option("--make-key", &make_key, "write a fresh key file (0600) for --key and exit");
   cl.option("--foxglove", &foxglove_port,
             "[PORT] also serve the live run to Foxglove (dlslot-foxglove, WebSocket on 127.0.0.1:PORT, default 8765)");
   if (!cl.parse(argc, argv)) return 0;
   const bool foxglove = foxglove_port >= 0;
+  if (!make_key.empty()) {
+    const RunKey key = makeRunKey();
+    writeKeyFile(make_key, key);
+    std::cout << "wrote key " << make_key << " (run id " << key.runIdHex() << "); give it to every machine with --key\n";
+    return 0;
+  }
+  if (insecure && !key_file.empty()) throw std::invalid_argument("--insecure and --key exclude each other");
+  // Not given: all frames, lockstep. Given, they must mean something (--frames -3 once played
+  // everything, --speed 0, -1 or nan meant lockstep without a word).
+  if (frames == kNotGiven)
+    frames = -1;
+  else if (frames <= 0)
+    throw std::invalid_argument("--frames: expected a number of frames >= 1, got " + std::to_string(frames));
+  if (std::isnan(speed))
+    speed = 0;  // lockstep
+  else if (!(speed > 0))
+    throw std::invalid_argument("--speed: expected a real-time factor > 0, got " + std::to_string(speed) +
+                                " (lockstep, the default, needs no --speed)");
+  const std::pair<const char*, double> durations[] = {
+      {"--stall-timeout", stall_s}, {"--heartbeat-timeout", heartbeat_s}};
+  for (const auto& [name, v] : durations)
+    if (!(v > 0)) throw std::invalid_argument(std::string(name) + ": expected seconds > 0, got " + std::to_string(v));
+  // A heartbeat comes once a second: a timeout under two of them fails a healthy run.
+  if (heartbeat_s < 2)
+    throw std::invalid_argument("--heartbeat-timeout: expected >= 2 s (processes report once a second), got " +
+                                std::to_string(heartbeat_s));
   if (out.empty()) throw std::invalid_argument("--out DIR is required");
   if (in_flight < 1) throw std::invalid_argument("--in-flight: expected an integer >= 1");
   config = fs::absolute(findConfigFile(config)).string();  // the children get the same file from any directory
@@ -219,6 +254,21 @@ int runPipeline(int argc, char** argv) {
   out = fs::canonical(out).string();
   const std::string logs = out + "/logs";
   run::Supervisor sup;
+
+  // 0. The run's key (message_auth.hpp): every child finds it through $DLSLOT_KEY_FILE, never on
+  // a command line; the run folder keeps it so the log can be verified (and replayed) later.
+  const std::string run_key = out + "/" + kRunKeyFile;
+  if (insecure) {
+    fs::remove(run_key);  // an old run's key would make the readers refuse this run's plain log
+    useNoKey();
+    std::cerr << "authentication: off (--insecure): anything on the LCM URL can publish into this run\n";
+  } else {
+    const RunKey key = key_file.empty() ? makeRunKey() : readKeyFile(fs::absolute(key_file).string());
+    if (key_file.empty() || fs::absolute(key_file) != fs::absolute(run_key)) writeKeyFile(run_key, key);
+    useKeyFile(run_key);
+    std::cerr << "authentication: run key " << run_key << " (run " << key.runIdHex() << ")"
+              << (key_file.empty() ? "" : ", from " + key_file) << "\n";
+  }
 
   // 1. The config is checked by every process before anything starts.
   {
@@ -258,7 +308,48 @@ int runPipeline(int argc, char** argv) {
   const int last_frame = (frames > 0 && scenario.empty()) ? std::min(frames, num_frames) - 1 : num_frames - 1;
 
   // 3. Start the pipeline, consumers first.
-  Node node("launcher", lcm_url);
+  Channels channels;
+  loadPipelineConfig(config, channels);
+  Node node("launcher", lcm_url, channels);
+  std::map<std::string, process_status_t> health;
+  std::map<std::string, Node::Clock::time_point> heard;               // last heartbeat per process
+  std::map<std::string, std::vector<std::pair<double, int64_t>>> rss;  // (s since start, kB) per process
+  int slot_frames = 0, slot_last = -1;
+  const auto run_start = Node::Clock::now();
+  auto last_progress = run_start, last_slot_time = last_progress;
+  node.subscribe<process_status_t>(channels.status, [&](const process_status_t& s) {
+    health[s.name] = s;
+    const auto now = Node::Clock::now();
+    heard[s.name] = now;
+    if (const int64_t kb = statusCounter(s, "rss_kb"); kb > 0)
+      rss[s.name].emplace_back(std::chrono::duration<double>(now - run_start).count(), kb);
+  });
+  node.subscribeFrames<slot_state_t>(channels.slot_state, [&](const slot_state_t& s) {
+    ++slot_frames;
+    slot_last = s.frame;
+    last_progress = last_slot_time = Node::Clock::now();
+  });
+  // Another run on this LCM URL: its processes report once a second. Heard before ours start
+  // (accepted, or refused as another run's or unauthenticated), it would take our messages for
+  // its own or stall on them: refuse to start, naming the URL.
+  {
+    const auto refusedStatus = [&] {
+      int64_t n = 0;
+      for (const auto& [key, count] : node.status().refusals())
+        if (key.rfind(channels.status + ".", 0) == 0) n += count;
+      return n;
+    };
+    node.spinUntil([&] { return !health.empty() || refusedStatus() > 0; }, 1.2);
+    if (!health.empty() || refusedStatus() > 0) {
+      std::string who;
+      for (const auto& [name, st] : health) who += " " + name + " (pid " + std::to_string(st.pid) + ")";
+      if (who.empty()) who = " " + std::to_string(refusedStatus()) + " PROCESS_STATUS messages of another run";
+      const char* env = std::getenv("LCM_DEFAULT_URL");
+      const std::string url = !lcm_url.empty() ? lcm_url : env ? env : "LCM's default";
+      throw Failure("another DL-SLOT run is using the LCM URL " + url + ": heard" + who +
+                    ". Give each run its own port (--lcm-url udpm://239.255.76.67:PORT?ttl=0) or wait for it to end");
+    }
+  }
   std::vector<std::string> common = {"--config", config};
   if (!lcm_url.empty()) common.insert(common.end(), {"--lcm-url", lcm_url});
   auto args = [&](const std::string& exe, std::vector<std::string> extra) {
@@ -313,28 +404,24 @@ int runPipeline(int argc, char** argv) {
     std::cerr << "\n";
   }
 
-  std::map<std::string, process_status_t> health;
-  std::map<std::string, Node::Clock::time_point> heard;               // last heartbeat per process
-  std::map<std::string, std::vector<std::pair<double, int64_t>>> rss;  // (s since start, kB) per process
-  int slot_frames = 0, slot_last = -1;
-  const auto run_start = Node::Clock::now();
-  auto last_progress = run_start, last_slot_time = last_progress;
-  node.subscribe<process_status_t>("PROCESS_STATUS", [&](const process_status_t& s) {
-    health[s.name] = s;
-    const auto now = Node::Clock::now();
-    heard[s.name] = now;
-    if (const int64_t kb = statusCounter(s, "rss_kb"); kb > 0)
-      rss[s.name].emplace_back(std::chrono::duration<double>(now - run_start).count(), kb);
-  });
-  node.subscribeFrames<slot_state_t>("SLOT_STATE", [&](const slot_state_t& s) {
-    ++slot_frames;
-    slot_last = s.frame;
-    last_progress = last_slot_time = Node::Clock::now();
-  });
   auto failIfDead = [&](const std::string& except) {
-    while (auto e = sup.reap())
-      if (e->name != except || e->code != 0)
-        throw Failure(e->name + " " + e->how + "; its last lines (" + sup.logPath(e->name) + "):\n" + sup.tail(e->name));
+    while (auto e = sup.reap()) {
+      if (e->name == except && e->code == 0) continue;
+      std::string lines = sup.tail(e->name);
+      if (lines.find_first_not_of(" \n") == std::string::npos) lines = "(it printed nothing)\n";
+      // On a full disk the logger's own log (on the same disk) may hold nothing: say what can be seen.
+      if (e->name == "lcm-logger") {
+        std::error_code ec;
+        const auto space = fs::space(out, ec);
+        const auto size = fs::file_size(out + "/run.lcmlog", ec);
+        lines += "run.lcmlog holds " + (ec ? std::string("nothing") : std::to_string(size) + " bytes") + "; " +
+                 (space.available == static_cast<std::uintmax_t>(-1)
+                      ? std::string("free space unknown")
+                      : std::to_string(space.available) + " bytes free on the disk of " + out) +
+                 ": a full disk or a file that cannot be written stops the logger\n";
+      }
+      throw Failure(e->name + " " + e->how + "; its last lines (" + sup.logPath(e->name) + "):\n" + lines);
+    }
   };
   auto allUp = [&] {
     for (const auto& p : pipeline)
@@ -366,7 +453,8 @@ int runPipeline(int argc, char** argv) {
       throw Failure(p + " stalled: no PROCESS_STATUS (heartbeat) for " + std::to_string(int(heartbeat_s)) +
                     " s though it is still running (stopped or hung); its last frame " +
                     std::to_string(h == health.end() ? -1 : h->second.last_frame) + "; its last lines (" +
-                    sup.logPath(p) + "):\n" + sup.tail(p));
+                    sup.logPath(p) + "):\n" + sup.tail(p) + "\nframes so far (from the last PROCESS_STATUS of each):\n" +
+                    accountFrames(health, last_frame + 1, accounted).table());
     }
   };
   std::vector<std::string> play = {"--quiet", "--delay", "0.2", "--end", std::to_string(last_frame)};
@@ -419,6 +507,19 @@ int runPipeline(int argc, char** argv) {
   }
   if (!quiet) progress.finish(healthText());
   failIfDead("player");
+  // Every process must still be reporting before it is asked to stop: one whose heartbeat is late
+  // may be stopped (SIGSTOP) or hung while the others solved its frames without it (a rate-mode
+  // run ends all the same). Wait until it reports again or failIfSilent names it, rather than kill
+  // it and call it "did not exit cleanly".
+  for (bool late = true; late;) {
+    late = false;
+    for (const auto& p : pipeline)
+      late = late || !heard.count(p) || std::chrono::duration<double>(Node::Clock::now() - heard[p]).count() > 2.5;
+    if (!late) break;
+    failIfDead("player");
+    failIfSilent();
+    node.spinUntil([] { return false; }, 0.1);
+  }
 
   // 5. Stop in pipeline order so every process flushes (the renderer writes its summary, the
   // logger closes the log).
@@ -433,6 +534,17 @@ int runPipeline(int argc, char** argv) {
     const int code = sup.stop(p, grace, listen);
     if (code != 0) throw Failure(p + " did not exit cleanly (code " + std::to_string(code) + "):\n" + sup.tail(p));
   }
+  // UDP datagrams the kernel dropped in this namespace during the run on sockets that do not
+  // report their own (the logger's, the launcher's): published in the launcher's PROCESS_STATUS
+  // (udp_drops_elsewhere) while the logger still records, so the terminal, report.md and
+  // metrics.json add up the same counters.
+  if (const int64_t after = udpReceiveBufferErrors(); after >= 0 && kernel_drops_before >= 0) {
+    int64_t reported = 0;
+    for (const auto& [name, st] : health) reported += statusCounter(st, "udp_drops");
+    node.status().set("udp_drops_elsewhere", std::max<int64_t>(0, after - kernel_drops_before - reported));
+  }
+  node.publishStatus();
+  health["launcher"] = node.status().toMessage();
   node.spinUntil([] { return false; }, 0.3);
   sup.stop("lcm-logger");
   // Where the two cores went: each process's CPU time over the whole run, per played frame.
@@ -461,9 +573,7 @@ int runPipeline(int argc, char** argv) {
   writeSpeed(out + "/speed.yaml", cpu_ms, rate, load_before, loadAverage());
   if (slot_frames != last_frame + 1) std::cerr << "warning: frames are missing from SLOT_STATE\n";
   // Where every frame went, and the memory of each process over the run.
-  FrameAccounting accounting = accountFrames(health, last_frame + 1, accounted);
-  if (const int64_t after = udpReceiveBufferErrors(); after >= 0 && kernel_drops_before >= 0)
-    accounting.kernel_drops = std::max(accounting.kernel_drops, after - kernel_drops_before);  // the logger's too
+  const FrameAccounting accounting = accountFrames(health, last_frame + 1, accounted);
   std::cerr << accounting.table();
   std::cerr << "memory (RSS MB, start / middle / end):\n";
   for (const auto& [p, samples] : rss)

@@ -75,6 +75,9 @@ struct Channels {
   std::string associations = "ASSOCIATIONS";
   std::string slot_state = "SLOT_STATE";
   std::string status = "PROCESS_STATUS";
+  std::string run_event = "RUN_EVENT";  // optional key (the player's start events)
+  // Reads the section; every channel must have a name of its own: two roles on one channel (e.g.
+  // odometry: SLOT_STATE) would feed one process's output to another as a different type.
   void read(ConfigSection section);
 };
 

@@ -9,9 +9,11 @@
 //   2. decodes with lcm-gen's decoder, catching anything it throws;
 //   3. validates the content: finite values, unit quaternions, sizes > 0, enums in range, frame
 //      numbers in [0, kMaxFrame] (so `frame + 1` and gap counts never overflow).
-// Boxes in DETECTIONS and ASSOCIATIONS are the exception to 3: their consumers refuse a
-// malformed box one by one (counted as rejected detections), so one bad box does not cost the
-// whole scan. FrameOrder adds the per-channel check that a frame is new and near the last one.
+// Boxes are checked like every other field: a DETECTIONS or ASSOCIATIONS message with a box that
+// is not finite or has a size <= 0 is refused whole, before any of it reaches a node's state (no
+// process of the pipeline publishes such a box, so such a message is not the pipeline's: one with
+// a NaN box and frame 500 must not become a node's newest frame). FrameOrder adds the per-channel
+// check that a frame is new and near the last one.
 #pragma once
 
 #include <cstddef>
@@ -24,17 +26,15 @@
 #include "dlslot/odometry_t.hpp"
 #include "dlslot/point_cloud_t.hpp"
 #include "dlslot/process_status_t.hpp"
+#include "dlslot/run_event_t.hpp"
 #include "dlslot/slot_state_t.hpp"
 
 namespace dlslot {
 
 // KITTI names scans by six digits (000000.bin): no sequence has a frame beyond this.
 constexpr int kMaxFrame = 999999;
-// A frame more than this ahead of the last one on its channel is refused (100 s at 10 Hz)...
+// A frame more than this ahead of the last one on its channel is refused (100 s at 10 Hz).
 constexpr int kMaxFrameJump = 1000;
-// ...unless this many refused frames in a row follow each other (a stream that really moved on,
-// e.g. a player started again): then the channel follows them.
-constexpr int kFrameResync = 3;
 
 // Why a message was refused: `reason` is a short key for counters ("bad_count", "non_finite",
 // ...), `detail` says which field and what was expected. Empty reason: accepted.
@@ -51,6 +51,7 @@ Refusal checkLayout(const odometry_t*, const void* data, size_t size);
 Refusal checkLayout(const associations_t*, const void* data, size_t size);
 Refusal checkLayout(const slot_state_t*, const void* data, size_t size);
 Refusal checkLayout(const process_status_t*, const void* data, size_t size);
+Refusal checkLayout(const run_event_t*, const void* data, size_t size);
 
 // Step 3 for each type: the decoded values make sense.
 Refusal checkContent(const point_cloud_t& m);
@@ -60,6 +61,7 @@ Refusal checkContent(const odometry_t& m);
 Refusal checkContent(const associations_t& m);
 Refusal checkContent(const slot_state_t& m);
 Refusal checkContent(const process_status_t& m);
+Refusal checkContent(const run_event_t& m);
 
 // All three steps; `out` is only meaningful when the result is empty.
 template <class Msg>
@@ -76,15 +78,17 @@ Refusal decodeChecked(const void* data, size_t size, Msg* out) {
 }
 
 // The frames accepted on one channel: each new (no duplicate, none older than the last) and at
-// most kMaxFrameJump ahead, with a resync after kFrameResync consecutive refused frames.
+// most kMaxFrameJump ahead. No number of refused frames makes a channel follow a new numbering
+// (anyone who can publish could then steer it); a new numbering begins only with the player's
+// explicit start event (Node::onRestart), which calls reset().
 class FrameOrder {
  public:
   Refusal accept(int frame);
   int last() const { return last_; }  // -1 before the first
+  void reset() { last_ = -1; }
 
  private:
   int last_ = -1;
-  int run_start_ = -1, run_length_ = 0;  // consecutive refused frames, for the resync
 };
 
 }  // namespace dlslot

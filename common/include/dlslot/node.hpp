@@ -15,8 +15,10 @@
 #include <vector>
 
 #include "dlslot/config.hpp"
+#include "dlslot/message_auth.hpp"
 #include "dlslot/message_guard.hpp"
 #include "dlslot/process_status_t.hpp"
+#include "dlslot/run_event_t.hpp"
 #include "dlslot/timing_stats.hpp"
 
 namespace dlslot {
@@ -33,6 +35,10 @@ class CommandLine {
   void option(const std::string& name, int* value, const std::string& help);
   void repeated(const std::string& name, std::vector<std::string>* values, const std::string& help);
   void flag(const std::string& name, bool* value, const std::string& help);
+  // An option whose value is handed to `apply` as it is parsed (apply may throw invalid_argument);
+  // a switch (no value) when `takes_value` is false.
+  void action(const std::string& name, std::function<void(const std::string&)> apply, const std::string& help,
+              bool takes_value = true);
   // Parses argv. Prints usage and returns false for --help; throws std::invalid_argument with a
   // clear message for an unknown option or a bad value.
   bool parse(int argc, char** argv);
@@ -48,13 +54,19 @@ class CommandLine {
   std::vector<Opt> opts_;
 };
 
-// The options every process takes: --config FILE, --lcm-url URL, --check-config.
+// The options every process takes: --config FILE, --lcm-url URL, --check-config, and the
+// authentication of its messages (message_auth.hpp): --key FILE (sets $DLSLOT_KEY_FILE, which
+// the launcher sets for its children) or --insecure (no key: today's open LCM).
 struct NodeOptions {
   std::string config = "config/dlslot.yaml";
   std::string lcm_url;  // empty: $LCM_DEFAULT_URL or LCM's default
   bool check_config = false;
   void addTo(CommandLine& cl);
 };
+// What --key FILE and --insecure do: point $DLSLOT_KEY_FILE at FILE (checked at once, made
+// absolute), or clear it. Every Node made afterwards uses that key (or none).
+void useKeyFile(const std::string& path);
+void useNoKey();
 
 // Counters and timing a process reports in PROCESS_STATUS.
 class ProcessStatus {
@@ -113,13 +125,28 @@ class Node {
   // is refused (FrameOrder), a jump in the frame index is a gap.
   template <class Msg>
   void subscribeFrames(const std::string& channel, std::function<void(const Msg&)> cb);
+  // Encodes `msg` and publishes it, in an authenticated envelope when the process has a key.
   template <class Msg>
   void publish(const std::string& channel, const Msg& msg) {
-    if (channel != channels_.scan) checkSize(channel, msg.getEncodedSize());
-    if (lcm_.publish(channel, &msg) != 0) status_.error("publish on " + channel + " failed");
+    const int size = msg.getEncodedSize();
+    if (channel != channels_.scan) checkSize(channel, size);
+    out_buf_.resize(auth_.headerBytes() + static_cast<size_t>(size) + auth_.tagBytes());
+    if (msg.encode(out_buf_.data() + auth_.headerBytes(), 0, size) != size) {
+      status_.error("encoding a message for " + channel + " failed");
+      return;
+    }
+    publishSealed(channel, static_cast<size_t>(size));
   }
-  // Publishes bytes already encoded (e.g. encodeScan's).
+  // Publishes already-encoded bytes (in an envelope when the process has a key).
   void publishEncoded(const std::string& channel, const void* data, size_t size);
+  const MessageAuth& auth() const { return auth_; }
+
+  // Calls `cb` when the player starts a run again (a "start" RUN_EVENT after this node handled
+  // frames): every channel's frame order is reset first, so the new numbering is accepted. The only
+  // way a node starts over: old, duplicate or far frames never reset one (message_guard.hpp).
+  void onRestart(std::function<void(const run_event_t&)> cb) { restart_handlers_.push_back(std::move(cb)); }
+  // Publishes the player's "start" event.
+  void publishStart(int first_frame, const std::string& sequence);
 
   // Calls cb every period_s seconds from the loop.
   void every(double period_s, std::function<void()> cb);
@@ -137,6 +164,8 @@ class Node {
  private:
   void handleOnce(double max_wait_s);
   void noteFrameReceived(int frame);
+  void publishSealed(const std::string& channel, size_t payload_size);
+  void dispatch(const std::string& channel, const lcm::ReceiveBuffer& rbuf);
   void noteSubscription(const std::string& channel);
   // A message this large on a channel other than the scan is trimmed away by the large-message
   // filter of every process that takes no scans (large_message_filter.hpp): reported as an error.
@@ -154,8 +183,19 @@ class Node {
   std::map<std::string, FrameOrder> frame_order_;
   std::set<int> frames_received_;  // distinct frames that any frame channel carried
   int recv_fd_ = -1;               // LCM's receive socket, for its kernel drop count
-  bool filtering_large_ = false;    // the large-message filter is on recv_fd_ (no scan subscription)
-  std::list<RawHandler> handlers_;  // stable addresses: LCM keeps a pointer to each
+  void handleRunEvent(const run_event_t& e);
+  MessageAuth auth_;
+  std::vector<uint8_t> out_buf_;
+  std::vector<std::function<void(const run_event_t&)>> restart_handlers_;
+  // One LCM subscription per channel (so an envelope is verified once, whatever the number of
+  // handlers): stable addresses, LCM keeps a pointer to each channel's entry.
+  struct ChannelHandlers {
+    Node* node;
+    std::string channel;
+    std::vector<RawHandler> handlers;
+  };
+  std::list<ChannelHandlers> handlers_;
+  bool filtering_large_ = false;  // the large-message filter is on recv_fd_ (no scan subscription)
   bool stop_ = false;
 };
 

@@ -133,8 +133,9 @@ void MessageAuth::seal(const std::string& channel, uint8_t* buf, size_t payload_
   uint8_t nonce[24];
   nonceFor(channel, buf, nonce);
   unsigned long long tag_len = 0;
-  crypto_aead_xchacha20poly1305_ietf_encrypt_detached(nullptr, buf + kEnvelopeHeader + payload_size, &tag_len, nullptr,
-                                                      0, buf, kEnvelopeHeader + payload_size, nullptr, nonce,
+  uint8_t no_ciphertext = 0;  // the plaintext is empty: everything is authenticated data
+  crypto_aead_xchacha20poly1305_ietf_encrypt_detached(&no_ciphertext, buf + kEnvelopeHeader + payload_size, &tag_len,
+                                                      nullptr, 0, buf, kEnvelopeHeader + payload_size, nullptr, nonce,
                                                       key_->secret.data());
 }
 
@@ -169,7 +170,8 @@ Refusal MessageAuth::open(const std::string& channel, const void* data, size_t s
   const size_t n = size - kEnvelopeHeader - kEnvelopeTag;
   uint8_t nonce[24];
   nonceFor(channel, b, nonce);
-  if (crypto_aead_xchacha20poly1305_ietf_decrypt_detached(nullptr, nullptr, nullptr, 0, b + kEnvelopeHeader + n, b,
+  const uint8_t no_ciphertext = 0;  // the plaintext is empty: everything is authenticated data
+  if (crypto_aead_xchacha20poly1305_ietf_decrypt_detached(nullptr, nullptr, &no_ciphertext, 0, b + kEnvelopeHeader + n, b,
                                                           kEnvelopeHeader + n, nonce, key_->secret.data()) != 0)
     return {"bad_mac", "the message's MAC does not verify with this run's key"};
   std::array<uint8_t, 16> publisher;

@@ -15,6 +15,7 @@
 #include "dlslot/odometry_t.hpp"
 #include "dlslot/process_status_t.hpp"
 #include "dlslot/slot_state_t.hpp"
+#include "dlslot/message_auth.hpp"
 #include "process_harness.hpp"
 
 using namespace dlslot;
@@ -156,7 +157,10 @@ TEST(PipelineProcess, FramesInFlightGiveStrictLockstepResults) {
     std::map<int, bool> slot_seen;
     lcm::LogFile f(log, "r");
     for (const lcm::LogEvent* e = f.readNextEvent(); e; e = f.readNextEvent()) {
-      const int frame = frameOfEncoded(e->data, e->datalen);
+      // The run authenticates its messages: the LCM bytes sit inside the envelope (message_auth.hpp).
+      const bool sealed = isEnvelope(e->data, e->datalen);
+      const uint8_t* data = static_cast<const uint8_t*>(e->data) + (sealed ? kEnvelopeHeader : 0);
+      const int frame = frameOfEncoded(data, e->datalen - (sealed ? kEnvelopeHeader + kEnvelopeTag : 0));
       if (e->channel == "SLOT_STATE") slot_seen[frame] = true;
       if (e->channel == "LIDAR_SCAN" && frame > 0 && !slot_seen[frame - 1]) ++frames;
     }

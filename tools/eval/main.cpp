@@ -399,7 +399,7 @@ int run(int argc, char** argv) {
     run.frame_counts = log->frame_counts;
     addProcessNotes(*log, run);
     std::vector<std::string> pipeline;
-    for (const std::string p : {"detector", "odometry", "tracker", "backend", "renderer"})
+    for (const std::string p : {"detector", "odometry", "tracker", "backend", "renderer", "mapper"})
       if (log->last_status.count(p)) pipeline.push_back(p);
     run.frames = accountFrames(log->last_status, log->frame_counts[channels.scan], pipeline);
     for (const auto& [process, samples] : log->rss_kb)

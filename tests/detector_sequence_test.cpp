@@ -1,5 +1,5 @@
 // The detector on a short simulated sequence (the intersection scenario, labels all around): its
-// recall per class against the simulator's labels, with the evaluation the README reports
+// recall per class against the simulator's labels, with the evaluation docs/detector.md reports
 // (bird's-eye centre distance <= 2 m, within 40 m).
 #include <gtest/gtest.h>
 
@@ -30,7 +30,7 @@ TEST(DetectorSequence, RecallOnSimulatedIntersection) {
     for (size_t c = 0; c < classes.size(); ++c) counts[c].add(matchFrame(labels, r.boxes, classes[c], EvalOptions{}));
   }
   // Measured on these 8 frames: Car 1.00 of 24 (precision 0.57), Pedestrian 0.84 of 19 (the
-  // README's 60-frame numbers are 0.995 and 0.80). The thresholds leave room for small tuning only.
+  // docs/detector.md's 60-frame numbers are 0.995 and 0.80). The thresholds leave room for small tuning only.
   ASSERT_GE(counts[0].labels, 10);
   ASSERT_GE(counts[1].labels, 5);
   EXPECT_GE(counts[0].recall(), 0.9) << counts[0].matched << " of " << counts[0].labels << " cars";

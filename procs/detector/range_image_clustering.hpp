@@ -5,7 +5,7 @@
 //
 // Chosen over PCL's EuclideanClusterExtraction (k-d tree radius search) because it is faster on
 // the same points: on the real KITTI scans (kitti-tracking-0000-head, ~123k points, ~45k obstacle
-// points) bench/detector_bench.cpp measured the numbers quoted in the README's detector section.
+// points) bench/detector_bench.cpp measured the numbers quoted in docs/detector.md.
 // The neighbourhood comes from the scan's own structure, so no tree is built.
 #pragma once
 

@@ -6,7 +6,7 @@
 // Why hand-written: on the real KITTI slice Ceres' Levenberg-Marquardt over the same residuals
 // took 32 % of the odometry's instructions (callgrind, 3.2 G of 10.1 G for 30 scans), most of
 // it problem construction and per-block bookkeeping for a problem with 6 unknowns;
-// `odometry_bench --benchmark_filter=PoseSolve` compares the two on real matches (README).
+// `odometry_bench --benchmark_filter=PoseSolve` compares the two on real matches (docs/results.md).
 // The residuals are the ones of edge_residual.hpp / plane_residual.hpp, which the Ceres
 // reference solve (solvePoseCeres) still uses; tests check both against numeric differences.
 #pragma once

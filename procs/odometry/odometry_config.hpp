@@ -50,7 +50,7 @@ struct ScanToScanConfig {
   // registration that fails or jumps (max_correction_*; it is then redone from the scan-to-scan
   // result). As KISS-ICP registers to its map from a constant-velocity prediction alone. On the
   // real slice the same accuracy for a third less CPU, on the simulated drives better t_rel
-  // (scan-to-scan locks onto passing traffic): README, "Odometry speed".
+  // (scan-to-scan locks onto passing traffic): docs/results.md, "Odometry speed".
   bool every_scan = false;
   SolverConfig solver;
   double max_match_distance_m = 5.0;  // nearest previous feature farther than this: no match
@@ -64,7 +64,7 @@ struct ScanToScanConfig {
 // Scan-to-map refinement against a local map (A-LOAM laserMapping).
 struct ScanToMapConfig {
   // A solve that moves the pose less than 5 cm / 0.25 deg ends the search: a second search after
-  // such a step leaves the accuracy on the real slice and the simulated drives as it is (README,
+  // such a step leaves the accuracy on the real slice and the simulated drives as it is (docs/results.md,
   // "Odometry speed"), and each search costs about as much as the rest of a frame.
   SolverConfig solver{2, 4, 0.1, 0.05, 0.25};
   double edge_voxel_m = 0.4;          // voxel size of the edge map and of the scan's edge queries

@@ -1,5 +1,7 @@
 #include "foxglove_convert.hpp"
 
+#include "palette.hpp"  // procs/renderer: the same track colours as the bird's-eye images
+
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -49,22 +51,6 @@ std::string fixed(double v, int decimals) {
   return buf;
 }
 
-void hsv(double h, double s, double v, float rgba[4]) {
-  h = std::fmod(h, 1.0) * 6;
-  const int i = static_cast<int>(h);
-  const double f = h - i, p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
-  double r = v, g = t, b = p;
-  switch (i % 6) {
-    case 0: r = v, g = t, b = p; break;
-    case 1: r = q, g = v, b = p; break;
-    case 2: r = p, g = v, b = t; break;
-    case 3: r = p, g = q, b = v; break;
-    case 4: r = t, g = p, b = v; break;
-    default: r = v, g = p, b = q; break;
-  }
-  rgba[0] = float(r), rgba[1] = float(g), rgba[2] = float(b);
-}
-
 }  // namespace
 
 void classColour(const std::string& type, float rgba[4]) {
@@ -81,12 +67,10 @@ void classColour(const std::string& type, float rgba[4]) {
 }
 
 void idColour(int id, float rgba[4]) {
+  // The renderer's colour of the track, so a track looks the same in Foxglove and in bev/.
+  const cv::Scalar bgr = renderer::trackColour(id);
+  rgba[0] = float(bgr[2] / 255.0), rgba[1] = float(bgr[1] / 255.0), rgba[2] = float(bgr[0] / 255.0);
   rgba[3] = 0.55f;
-  if (id < 0) {
-    rgba[0] = rgba[1] = rgba[2] = 0.7f;
-    return;
-  }
-  hsv(0.61803398875 * id, 0.75, 1.0, rgba);
 }
 
 Converter::Converter(const Channels& channels, ConverterOptions options) : channels_(channels), opt_(options) {

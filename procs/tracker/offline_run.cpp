@@ -43,7 +43,9 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
   // Speeds over ground need ego poses: with none (every pose the identity, tracking in the sensor
   // frame) a parked object moves at the ego's speed, so the class's speed limits cannot be judged.
   AssociatorConfig cfg = config;
-  MotionEvidence motion{true, config.dynamic_displacement_m};
+  MotionEvidence motion;
+  motion.ego_poses_known = true;
+  motion.moved_m = config.dynamic_displacement_m;
   if (std::all_of(ego_poses.begin(), ego_poses.begin() + reader.size(),
                   [](const Pose& X) { return X.matrix().isIdentity(0.0); })) {
     cfg.plausibility.clear();
@@ -78,7 +80,7 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
     for (const Association& a : r.associations) {
       ++out.associated;
       max_id = std::max(max_id, a.track_id);
-      evidence[a.track_id].add(frame.index, a.box_lidar.score, a.box_world.center);
+      evidence[a.track_id].add(frame.index, a.box_lidar.score, a.box_world.center, frame.utime * 1e-6);
       policy_of.emplace(a.track_id, policyFor(config.classes, a.box_lidar.type));
       if (a.relabelled) final_type[a.track_id] = a.box_lidar.type;
       const bool confirmed = a.status == TrackStatus::Confirmed;

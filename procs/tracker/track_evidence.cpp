@@ -8,13 +8,15 @@ namespace {
 constexpr double kGrid = 1.0 / (1 << 20);
 }
 
-void TrackEvidence::add(int frame, double score, const Eigen::Vector3d& world) {
+void TrackEvidence::add(int frame, double score, const Eigen::Vector3d& world, double time_s) {
   if (hits == 0 || frame < first_frame) {
     first_frame = frame;
+    first_time_s = time_s;
     first_position = world.head<2>();
   }
   if (hits == 0 || frame > last_frame) {
     last_frame = frame;
+    last_time_s = time_s;
     last_position = world.head<2>();
   }
   score_sum += std::isfinite(score) ? score : 0.0;
@@ -28,9 +30,8 @@ double evidenceFloor(const ClassPolicy& policy) {
 double trackScore(const TrackEvidence& e, const ClassPolicy& policy, const MotionEvidence& motion) {
   const double floor = evidenceFloor(policy);
   const double prior = policy.min_hits;
-  const bool moved = motion.ego_poses_known && e.displacement() > motion.moved_m;
   return (e.score_sum + floor * (e.missed() + prior)) / (e.hits + e.missed() + prior) +
-         (moved ? policy.moving_evidence : 0.0);
+         (motion.moved(e) ? policy.moving_evidence : 0.0);
 }
 
 double distinctGridScore(double v, std::set<double>& taken) {

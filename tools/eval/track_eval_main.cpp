@@ -12,6 +12,7 @@
 //   the confidences (a threshold set beforehand would cut their recall axis short).
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <cstdio>
 #include <filesystem>
@@ -193,10 +194,15 @@ int run(int argc, char** argv) {
                   s.c_str(), reader.size(), reader.hasScans() ? "" : " (no scans)", pose_source.c_str(), r.detections,
                   r.skipped.total(), r.skipped.untracked_type, r.skipped.below_score, r.skipped.duplicate,
                   r.tracks.size(), r.outside_image);
-    notes.push_back(note);
     KittiSequence seq{s, kitti::readTrackingLabels(reader.paths().labels), r.tracks, {}};
     for (int f = 0; f < reader.size(); ++f) seq.frames.push_back(f);
     const tracker::OfflineResult r_all = tracker::associateSequence(reader, ego, sweep_cfg.associator, sweep_cfg.output);
+    // The class decisions of the window (ClassPlausibility), by reason, in the all-tracks run.
+    const tracker::ClassDecisions& c = r_all.class_decisions;
+    std::snprintf(note + std::strlen(note), sizeof note - std::strlen(note),
+                  "; tracks re-labelled too fast %d, suppressed too fast %d, suppressed on another class %d (%d rows)",
+                  c.relabelled_too_fast, c.suppressed_too_fast, c.suppressed_on_other_class, r_all.suppressed_rows);
+    notes.push_back(note);
     kitti::writeTrackingLabels((fs::path(out) / "data_all" / (s + ".txt")).string(), r_all.tracks);
     KittiSequence seq_all{s, seq.labels, r_all.tracks, seq.frames};
     for (const kitti::LabelRow& row : r_all.tracks)

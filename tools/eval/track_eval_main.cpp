@@ -94,6 +94,20 @@ std::vector<Pose> perturbed(std::vector<Pose> poses, double sigma_m, double sigm
   return poses;
 }
 
+// Each ego pose moved by a random walk: translation steps N(0, step_m) along x and y, summed frame
+// by frame (a slow drift of the GPS/INS solution, as parked cars spread up to ~2 m in the world
+// frame over a KITTI sequence). Seeded.
+std::vector<Pose> drifted(std::vector<Pose> poses, double step_m, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, step_m);
+  Eigen::Vector3d drift = Eigen::Vector3d::Zero();
+  for (Pose& X : poses) {
+    drift += Eigen::Vector3d(n(rng), n(rng), 0.0);
+    X.translation() += drift;
+  }
+  return poses;
+}
+
 // Every detection as a track of its own: what the detections alone can recall (the ceiling no
 // tracker that reports detected boxes can pass).
 std::vector<kitti::LabelRow> detectionRows(const kitti::SequenceReader& reader) {
@@ -113,6 +127,7 @@ double recallOf(const KittiCounts& c) { return c.labels > 0 ? 1.0 - static_cast<
 
 int run(int argc, char** argv) {
   std::string root, poses, sequences_arg, out, config = kDefaultConfig, output, pose_noise, ab3dmot;
+  double pose_drift = 0;
   std::vector<std::string> detections;
   double min_iou = 0.25, frame_period = 0.1;
   bool quiet = false;
@@ -131,6 +146,8 @@ int run(int argc, char** argv) {
   cl.option("--frame-period", &frame_period, "seconds per frame (default 0.1)");
   cl.option("--pose-noise", &pose_noise, "M,DEG: perturb every ego pose by N(0, M) metres in x and y and N(0, DEG) "
                                          "degrees of yaw, independently per frame (a robustness test; seeded)");
+  cl.option("--pose-drift", &pose_drift, "M: add a random walk of N(0, M) metres a frame in x and y to the ego poses "
+                                         "(a slow drift of the solution; a robustness test; seeded)");
   cl.option("--ab3dmot-eval", &ab3dmot, "a checkout of xinshuoweng/AB3DMOT: also score OUT/data_all with its own "
                                         "scripts/KITTI/evaluate.py (scripts/ab3dmot-eval; several minutes) and "
                                         "print its numbers beside ours");
@@ -156,6 +173,8 @@ int run(int argc, char** argv) {
       throw std::invalid_argument("--pose-noise: expected M,DEG (two numbers >= 0), got '" + pose_noise + "'");
     noise_deg = std::strtod(v[1].c_str(), nullptr);
   }
+  if (!(pose_drift >= 0) || !std::isfinite(pose_drift))
+    throw std::invalid_argument("--pose-drift: expected metres >= 0, got " + std::to_string(pose_drift));
   if (!ab3dmot.empty() && !fs::exists(fs::path(ab3dmot) / "scripts" / "KITTI" / "evaluate.py"))
     throw std::invalid_argument("--ab3dmot-eval " + ab3dmot +
                                 ": no scripts/KITTI/evaluate.py there (expected a checkout of xinshuoweng/AB3DMOT)");
@@ -183,6 +202,10 @@ int run(int argc, char** argv) {
     if (!pose_noise.empty() && pose_source.rfind("no ego poses", 0) != 0) {
       ego = perturbed(std::move(ego), noise_m, noise_deg, 1000 + static_cast<unsigned>(i));
       pose_source += " perturbed by " + pose_noise;
+    }
+    if (pose_drift > 0 && pose_source.rfind("no ego poses", 0) != 0) {
+      ego = drifted(std::move(ego), pose_drift, 2000 + static_cast<unsigned>(i));
+      pose_source += " drifting by " + std::to_string(pose_drift) + " m a frame";
     }
     const tracker::OfflineResult r = tracker::associateSequence(reader, ego, cfg.associator, cfg.output);
     for (double ms : r.association_ms.samples()) association_ms.add(ms);

@@ -190,6 +190,8 @@ int run(int argc, char** argv) {
   std::map<std::string, std::map<std::string, KittiClassMetrics>> per_sequence;
   std::vector<std::string> notes;
   TimingStats association_ms;
+  tracker::ClassDecisions decisions;  // of the all-tracks run, over every sequence
+  int suppressed_rows = 0;
   ProgressLine progress("track-eval", static_cast<int>(sequences.size()));
   for (size_t i = 0; i < sequences.size(); ++i) {
     const std::string& s = sequences[i];
@@ -222,6 +224,8 @@ int run(int argc, char** argv) {
     const tracker::OfflineResult r_all = tracker::associateSequence(reader, ego, sweep_cfg.associator, sweep_cfg.output);
     // The class decisions of the window (ClassPlausibility), by reason, in the all-tracks run.
     const tracker::ClassDecisions& c = r_all.class_decisions;
+    decisions += c;
+    suppressed_rows += r_all.suppressed_rows;
     std::snprintf(note + std::strlen(note), sizeof note - std::strlen(note),
                   "; tracks re-labelled too fast %d, suppressed too fast %d, suppressed on another class %d (%d rows)",
                   c.relabelled_too_fast, c.suppressed_too_fast, c.suppressed_on_other_class, r_all.suppressed_rows);
@@ -279,6 +283,11 @@ int run(int argc, char** argv) {
     if (const auto d = ceiling.find(cls); d != ceiling.end())
       kv.emplace_back("tracking." + cls + ".recall_detections", recallOf(d->second.all));
   }
+  // The window's class decisions by reason (the all-tracks run, every sequence).
+  kv.emplace_back("class_decisions.relabelled_too_fast", decisions.relabelled_too_fast);
+  kv.emplace_back("class_decisions.suppressed_too_fast", decisions.suppressed_too_fast);
+  kv.emplace_back("class_decisions.suppressed_on_other_class", decisions.suppressed_on_other_class);
+  kv.emplace_back("class_decisions.suppressed_rows", suppressed_rows);
   kv.emplace_back("timing_ms.association.mean", association_ms.mean());
   kv.emplace_back("timing_ms.association.p95", association_ms.percentile(95));
   std::ofstream json(fs::path(out) / "metrics.json");

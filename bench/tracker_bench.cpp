@@ -21,8 +21,9 @@ struct Sequence {
   std::vector<std::vector<Box>> detections;  // lidar frame
 };
 
-// `objects` cars moving with constant speed and turn rate in a square of side `extent` metres.
-Sequence makeSequence(int objects, int frames, double extent, unsigned seed) {
+// `objects` cars (or pedestrians) moving with constant speed and turn rate in a square of side
+// `extent` metres.
+Sequence makeSequence(int objects, int frames, double extent, unsigned seed, bool pedestrians = false) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
   std::normal_distribution<double> noise(0, 0.1);
@@ -32,7 +33,8 @@ Sequence makeSequence(int objects, int frames, double extent, unsigned seed) {
   };
   std::vector<Obj> objs;
   for (int i = 0; i < objects; ++i)
-    objs.push_back({{extent * (u(rng) - 0.5), extent * (u(rng) - 0.5)}, 2 * M_PI * u(rng), 15 * u(rng), 0.3 * (u(rng) - 0.5)});
+    objs.push_back({{extent * (u(rng) - 0.5), extent * (u(rng) - 0.5)}, 2 * M_PI * u(rng),
+                    (pedestrians ? 2 : 15) * u(rng), 0.3 * (u(rng) - 0.5)});
   Sequence s;
   for (int f = 0; f < frames; ++f) {
     Pose X = Pose::Identity();
@@ -44,9 +46,12 @@ Sequence makeSequence(int objects, int frames, double extent, unsigned seed) {
       o.p += 0.1 * o.speed * Eigen::Vector2d(std::cos(o.heading), std::sin(o.heading));
       Box b;
       b.center << o.p.x() + noise(rng), o.p.y() + noise(rng), -0.8;
-      b.size << 4.2, 1.8, 1.5;
+      if (pedestrians)
+        b.size << 0.8, 0.6, 1.7;
+      else
+        b.size << 4.2, 1.8, 1.5;
       b.yaw = o.heading;
-      b.type = "Car";
+      b.type = pedestrians ? "Pedestrian" : "Car";
       dets.push_back(b.transformed(X.inverse()));
     }
     std::shuffle(dets.begin(), dets.end(), rng);
@@ -55,10 +60,14 @@ Sequence makeSequence(int objects, int frames, double extent, unsigned seed) {
   return s;
 }
 
-void associateFrame(benchmark::State& state, double extent) {
+void associateFrame(benchmark::State& state, double extent, bool pedestrians = false) {
   const int n = static_cast<int>(state.range(0)), frames = 1000, warmup = 10;
-  const Sequence seq = makeSequence(n, frames, extent, 1);
-  TrajectoryAssociator assoc;
+  const Sequence seq = makeSequence(n, frames, extent, 1, pedestrians);
+  AssociatorConfig cfg;
+  // The pedestrian class's plausibility rules of config/dlslot.yaml, both on: every box is
+  // checked against the boxes of the other classes' tracks of its frame.
+  if (pedestrians) cfg.plausibility["pedestrian"] = {3.5, "Cyclist", 0.5, true};
+  TrajectoryAssociator assoc(cfg);
   int f = frames;
   std::vector<double> ms;
   double tracks = 0;
@@ -88,6 +97,8 @@ void associateFrame(benchmark::State& state, double extent) {
 void BM_AssociateFrame(benchmark::State& state) { associateFrame(state, 200.0); }
 // A crowd in 40 m x 40 m: many admissible pairs, the Hungarian solver works hardest.
 void BM_AssociateFrameDense(benchmark::State& state) { associateFrame(state, 40.0); }
+// A crowd of pedestrians in 40 m x 40 m with the class plausibility rules on.
+void BM_AssociateFramePedestrians(benchmark::State& state) { associateFrame(state, 40.0, true); }
 
 void BM_Hungarian(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
@@ -102,5 +113,6 @@ void BM_Hungarian(benchmark::State& state) {
 
 BENCHMARK(BM_AssociateFrame)->Arg(50)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_AssociateFrameDense)->Arg(50)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_AssociateFramePedestrians)->Arg(50)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Hungarian)->Arg(10)->Arg(50)->Arg(100)->Unit(benchmark::kMicrosecond);
 BENCHMARK_MAIN();

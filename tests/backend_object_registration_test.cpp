@@ -22,12 +22,6 @@ namespace {
 const Eigen::Vector3d kSensor(0, 0, 1.73);
 const Eigen::Vector3d kCar(4.5, 1.8, 1.5);
 
-// Horizontal error of where M puts the object's centre (M's own translation mixes in its
-// rotation about the world origin; a box's height is hardly seen and matters to no velocity).
-double centreError(const Pose& M, const Pose& truth, const Pose& o0) {
-  return (M * o0.translation() - truth * o0.translation()).head<2>().norm();
-}
-
 // The largest error of the centre along a horizontal direction the result says it measured (to
 // better than 3 cm): a car seen from behind measures its motion along, not across, the line of sight.
 double measuredError(const RegistrationResult& r, const Pose& truth, const Pose& o0) {

@@ -113,7 +113,9 @@ RunResult runWithInjector(const std::string& data, const std::string& out, std::
   r.code = run.wait(0);
   r.text = run.output();
   r.sent = injector.sent;
-  if (inject) EXPECT_TRUE(injector.done) << "the run never reached frame " << kInjectAt << "\n" << r.text;
+  if (inject) {
+    EXPECT_TRUE(injector.done) << "the run never reached frame " << kInjectAt << "\n" << r.text;
+  }
   return r;
 }
 

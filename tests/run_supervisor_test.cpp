@@ -67,3 +67,26 @@ TEST(RunSupervisor, CpuTimeOfExitedChildren) {
   fs::remove(logPath("busy"));
   fs::remove(logPath("sleeper"));
 }
+
+// The grace of stop() is idle time: a child that keeps working after SIGINT (the renderer writing
+// its backlog on a loaded machine) is let finish past the grace; one that ignores SIGINT and
+// does nothing is killed once the grace has passed.
+TEST(RunSupervisor, StopWaitsForAWorkingChildAndKillsAnIdleOne) {
+  Supervisor sup;
+  // Ignores SIGINT, then burns CPU for ~1.5 s of its own time and exits 0.
+  sup.start("working", {"/bin/sh", "-c", "trap '' INT; end=$(($(date +%s%N) + 1500000000)); "
+                                         "while [ $(date +%s%N) -lt $end ]; do :; done; exit 0"},
+            logPath("working"));
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(sup.stop("working", 0.7), 0) << sup.tail("working");
+  EXPECT_GT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 0.7);
+
+  sup.start("idle", {"/bin/sh", "-c", "trap '' INT; sleep 30"}, logPath("idle"));
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const auto t1 = std::chrono::steady_clock::now();
+  EXPECT_EQ(sup.stop("idle", 0.7), 128 + SIGKILL);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count(), 5.0);
+  fs::remove(logPath("working"));
+  fs::remove(logPath("idle"));
+}

@@ -421,6 +421,60 @@ TEST(TrackerAssociator, AnImplausibleTrackWithoutATypeToBecomeIsSuppressed) {
   EXPECT_TRUE(associateWorld(a, 10, {}).coasting.empty());  // a missed frame: not reported either
 }
 
+// A parked car with a "pedestrian" box inside its footprint in every frame, the pedestrian box
+// the more confident of the two (so the one-frame duplicate rule, which drops the less confident
+// box centred inside the other, keeps both): once the window spans 0.5 s the pedestrian track is
+// the car seen twice, suppressed and counted once; a pedestrian walking past the car 2 m from
+// its side, and the car, are untouched.
+TEST(TrackerAssociator, APedestrianTrackInsideACarTrackIsSuppressedOnceAndCounted) {
+  AssociatorConfig cfg;
+  cfg.plausibility["pedestrian"] = {3.5, "Cyclist", 0.5, true};
+  TrajectoryAssociator a(cfg);
+  int suppressed = 0;
+  for (int f = 0; f < 15; ++f) {
+    Box car = makeBox({10, 3}, "Car", 0.3), inside = makeBox({10.9, 3.4}, "Pedestrian");
+    Box walker = makeBox({6 + 0.13 * f, 5.2}, "Pedestrian");
+    car.score = 3.0;
+    inside.score = 6.0;
+    walker.score = 4.0;
+    const FrameAssociations r = associateWorld(a, f, {car, inside, walker});
+    ASSERT_EQ(r.associations.size(), 3u) << f;
+    EXPECT_EQ(r.skipped.duplicate, 0) << f;
+    suppressed += r.class_decisions.suppressed_on_other_class;
+    EXPECT_EQ(r.class_decisions.suppressed_on_other_class, f == 5 ? 1 : 0) << f;
+    EXPECT_FALSE(r.associations[0].suppressed) << f;
+    EXPECT_EQ(r.associations[1].suppressed, f >= 5) << f;
+    EXPECT_FALSE(r.associations[2].suppressed) << f;
+    EXPECT_EQ(r.associations[1].track_id, 1) << f;  // still associated: its boxes start no new track
+    EXPECT_EQ(r.class_decisions.relabelled_too_fast + r.class_decisions.suppressed_too_fast, 0);
+  }
+  EXPECT_EQ(suppressed, 1);
+}
+
+// Two "pedestrian" tracks on one cyclist riding at 5.5 m/s: the first is re-labelled Cyclist at
+// 0.5 s; a second pedestrian box that then sits on it (0.2 m behind its centre) is that cyclist
+// again: suppressed, not made a second cyclist by its own speed. Without the rule it would be.
+TEST(TrackerAssociator, ASecondPedestrianTrackOnARelabelledCyclistIsSuppressedNotASecondCyclist) {
+  for (const bool yields : {true, false}) {
+    AssociatorConfig cfg;
+    cfg.plausibility["pedestrian"] = {3.5, "Cyclist", 0.5, yields};
+    TrajectoryAssociator a(cfg);
+    ClassDecisions total;
+    std::set<int> cyclist_ids;
+    for (int f = 0; f < 25; ++f) {
+      std::vector<Box> boxes = {makeBox({0.55 * f, 0}, "Pedestrian")};
+      if (f >= 8) boxes.push_back(makeBox({0.55 * f - 0.2, 0.1}, "Pedestrian"));
+      const FrameAssociations r = associateWorld(a, f, boxes);
+      total += r.class_decisions;
+      for (const Association& as : r.associations)
+        if (!as.suppressed && as.box_lidar.type == "Cyclist") cyclist_ids.insert(as.track_id);
+    }
+    EXPECT_EQ(total.relabelled_too_fast, yields ? 1 : 2) << yields;
+    EXPECT_EQ(total.suppressed_on_other_class, yields ? 1 : 0) << yields;
+    EXPECT_EQ(cyclist_ids.size(), yields ? 1u : 2u) << yields;
+  }
+}
+
 // --- one bad box ----------------------------------------------------------------------------
 // A car at 10 m/s whose box in frame 12 is placed 1.5 m to the side (PointRCNN does this about
 // once in 500 boxes). A line through the window follows it with one track; a cubic extrapolates

@@ -116,3 +116,30 @@ TEST(TrackEvidence, ScoresAreDistinctAndTheirMeansExactAfterTheFileRoundTrip) {
     }
   }
 }
+
+// Motion over ground as evidence (MotionEvidence): a walk of 2 m in 2 s counts; the same 2 m
+// spread over 20 s (0.1 m/s: GPS/INS drift under a parked object's long track) does not; 0.8 m
+// (under dynamic_displacement_m) does not; nothing counts without ego poses.
+TEST(TrackEvidence, MotionCountsAboveTheStaticLineAtAWalkingPace) {
+  ClassPolicy p = carPolicy(0.0);
+  p.moving_evidence = 0.5;
+  auto track = [](double metres, double seconds) {
+    TrackEvidence e;
+    const int n = static_cast<int>(seconds * 10) + 1;
+    for (int f = 0; f < n; ++f) e.add(f, 3.0, Eigen::Vector3d(metres * f / (n - 1), 7, 0), 0.1 * f);
+    return e;
+  };
+  MotionEvidence m;
+  m.ego_poses_known = true;
+  m.moved_m = 1.0;
+  const TrackEvidence walk = track(2.0, 2.0), drift = track(2.0, 20.0), shuffle = track(0.8, 1.0);
+  EXPECT_NEAR(walk.displacement(), 2.0, 1e-12);
+  EXPECT_NEAR(walk.duration(), 2.0, 1e-12);
+  EXPECT_TRUE(m.moved(walk));
+  EXPECT_FALSE(m.moved(drift));
+  EXPECT_FALSE(m.moved(shuffle));
+  EXPECT_DOUBLE_EQ(trackScore(walk, p, m) - trackScore(walk, p), 0.5);
+  EXPECT_DOUBLE_EQ(trackScore(drift, p, m), trackScore(drift, p));
+  m.ego_poses_known = false;
+  EXPECT_FALSE(m.moved(walk));
+}

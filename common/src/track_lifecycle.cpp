@@ -55,6 +55,7 @@ void ClassPolicy::validate() const {
   if (max_polynomial_degree < 1 || max_polynomial_degree > 3)
     fail("max_polynomial_degree: expected 1..3, got " + std::to_string(max_polynomial_degree));
   if (min_hits < 1) fail("min_hits: expected >= 1, got " + std::to_string(min_hits));
+  if (!std::isfinite(moving_evidence)) fail("moving_evidence: expected a finite number");
   if (max_misses < 0) fail("max_misses: expected >= 0, got " + std::to_string(max_misses));
   if (output_coasting_frames < 0 || output_coasting_frames > max_misses)
     fail("output_coasting_frames: expected 0..max_misses, got " + std::to_string(output_coasting_frames));

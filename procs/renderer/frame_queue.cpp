@@ -63,11 +63,21 @@ int FrameQueue::skipped() const {
 void FrameQueue::run() {
   // The lowest CPU priority (Linux nice is per thread): on a shared machine the estimator's
   // processes get the cores first; the images catch up when they are idle.
-  setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 19);
+  const id_t tid = static_cast<id_t>(syscall(SYS_gettid));
+  const int base_nice = getpriority(PRIO_PROCESS, tid);
+  setpriority(PRIO_PROCESS, tid, 19);
+  bool finishing = false;
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
     wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
     if (queue_.empty()) return;  // stop_
+    if (stop_ && !finishing) {
+      // The run is over: nothing is left to yield to, and on a loaded machine the backlog at
+      // nice 19 could take minutes. Raising a thread's priority back needs CAP_SYS_NICE (or
+      // RLIMIT_NICE); without it the backlog is written at 19 all the same.
+      finishing = true;
+      setpriority(PRIO_PROCESS, tid, base_nice);
+    }
     RenderInput in = std::move(queue_.front());
     queue_.pop_front();
     busy_ = true;

@@ -196,6 +196,7 @@ int run(int argc, char** argv) {
     // Tracks whose class the window overruled, by reason.
     status.count("tracks_relabelled_too_fast", result.class_decisions.relabelled_too_fast);
     status.count("tracks_suppressed_too_fast", result.class_decisions.suppressed_too_fast);
+    status.count("tracks_suppressed_on_other_class", result.class_decisions.suppressed_on_other_class);
 
     associations_t msg = toMsg(joined, ego, result);
     const double ms = std::chrono::duration<double, std::milli>(Node::Clock::now() - tic).count();

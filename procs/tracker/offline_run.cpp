@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <set>
 #include <stdexcept>
 
 #include "dlslot/input_error.hpp"
@@ -42,9 +43,14 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
   // Speeds over ground need ego poses: with none (every pose the identity, tracking in the sensor
   // frame) a parked object moves at the ego's speed, so the class's speed limits cannot be judged.
   AssociatorConfig cfg = config;
+  MotionEvidence motion;
+  motion.ego_poses_known = true;
+  motion.moved_m = config.dynamic_displacement_m;
   if (std::all_of(ego_poses.begin(), ego_poses.begin() + reader.size(),
-                  [](const Pose& X) { return X.matrix().isIdentity(0.0); }))
+                  [](const Pose& X) { return X.matrix().isIdentity(0.0); })) {
     cfg.plausibility.clear();
+    motion.ego_poses_known = false;
+  }
   TrajectoryAssociator associator(cfg);
   OfflineResult out;
   auto write = [&](int frame, const Box& box) {
@@ -59,6 +65,8 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
   int max_id = -1;
   std::map<int, TrackEvidence> evidence;
   std::map<int, const ClassPolicy*> policy_of;
+  std::map<int, std::string> final_type;  // tracks re-labelled by their class's plausibility
+  std::set<int> suppressed;               // tracks suppressed by it
   for (int i = 0; i < reader.size(); ++i) {
     const Frame frame = reader.read(i);
     const auto tic = std::chrono::steady_clock::now();
@@ -68,16 +76,17 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
     out.skipped.untracked_type += r.skipped.untracked_type;
     out.skipped.below_score += r.skipped.below_score;
     out.skipped.duplicate += r.skipped.duplicate;
-    out.class_decisions.relabelled_too_fast += r.class_decisions.relabelled_too_fast;
-    out.class_decisions.suppressed_too_fast += r.class_decisions.suppressed_too_fast;
+    out.class_decisions += r.class_decisions;
     for (const Association& a : r.associations) {
       ++out.associated;
       max_id = std::max(max_id, a.track_id);
-      evidence[a.track_id].add(frame.index, a.box_lidar.score);
+      evidence[a.track_id].add(frame.index, a.box_lidar.score, a.box_world.center, frame.utime * 1e-6);
       policy_of.emplace(a.track_id, policyFor(config.classes, a.box_lidar.type));
+      if (a.relabelled) final_type[a.track_id] = a.box_lidar.type;
       const bool confirmed = a.status == TrackStatus::Confirmed;
       out.confirmed += confirmed;
       if (a.suppressed) {
+        suppressed.insert(a.track_id);
         ++out.suppressed_rows;
         continue;
       }
@@ -93,8 +102,18 @@ OfflineResult associateSequence(const kitti::SequenceReader& reader, const std::
     }
   }
   out.trajectories = max_id + 1;
+  // A results file reports each track under the class its whole history decided, as it reports
+  // one score for it (below): the rows written before the window could judge (its first 0.5 s)
+  // take the decision too. A live consumer only gets it from the decision on.
+  const auto before = out.tracks.size();
+  out.tracks.erase(std::remove_if(out.tracks.begin(), out.tracks.end(),
+                                  [&](const kitti::LabelRow& row) { return suppressed.count(row.track_id) > 0; }),
+                   out.tracks.end());
+  out.suppressed_rows += static_cast<int>(before - out.tracks.size());
+  for (kitti::LabelRow& row : out.tracks)
+    if (const auto t = final_type.find(row.track_id); t != final_type.end()) row.type = t->second;
   // The score column: each track's evidence over its life (track_evidence.hpp).
-  writeTrackScores(out.tracks, evidence, policy_of);
+  writeTrackScores(out.tracks, evidence, policy_of, motion);
   return out;
 }
 

@@ -19,7 +19,7 @@ struct OfflineResult {
   int detections = 0, associated = 0, confirmed = 0, trajectories = 0;
   SkippedDetections skipped;            // detections not tracked (type, score, duplicate)
   ClassDecisions class_decisions;       // tracks re-labelled or suppressed by their class's plausibility
-  int suppressed_rows = 0;              // associations of suppressed tracks, not written
+  int suppressed_rows = 0;              // rows of suppressed tracks, not written (those before the decision too)
   int coasting = 0;                     // rows of confirmed tracks predicted through a detector miss
   int outside_image = 0;                // rows not written: the box is not in the camera image
 };

@@ -26,8 +26,10 @@ ClassPolicy readPolicy(const std::string& name, ConfigSection s, ClassPlausibili
   s.get("max_misses", p.max_misses);
   s.get("max_polynomial_degree", p.max_polynomial_degree);
   s.get("output_coasting_frames", p.output_coasting_frames);
+  s.get("moving_evidence", p.moving_evidence);
   s.get("max_speed_mps", plausible.max_speed_mps);  // .inf: no limit
   s.get("too_fast_type", plausible.too_fast_type);
+  s.get("yields_to_other_classes", plausible.yields_to_other_classes);
   s.finish();
   if (!(plausible.max_speed_mps > 0))
     throw ConfigError(s.file() + ": " + s.path() + ".max_speed_mps: expected > 0 (.inf for no limit), got " +

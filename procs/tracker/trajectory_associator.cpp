@@ -55,6 +55,16 @@ void AssociatorConfig::validate() const {
   }
 }
 
+namespace {
+
+// Whether `p` (bird's-eye view) lies inside box `o`'s footprint grown by `margin` on every side.
+bool insideFootprint(const Eigen::Vector2d& p, const Box& o, double margin) {
+  const Eigen::Vector2d local = Eigen::Rotation2Dd(-o.yaw) * (p - o.center.head<2>());
+  return std::abs(local.x()) <= 0.5 * o.size.x() + margin && std::abs(local.y()) <= 0.5 * o.size.y() + margin;
+}
+
+}  // namespace
+
 TrajectoryAssociator::TrajectoryAssociator(AssociatorConfig config) : config_(std::move(config)) { config_.validate(); }
 
 void TrajectoryAssociator::reset() {
@@ -117,12 +127,7 @@ std::vector<int> TrajectoryAssociator::trackedDetections(const std::vector<Box>&
   for (int v : candidates) {
     const Box& d = detections[v];
     const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](int k) {
-      const Box& o = detections[k];
-      if (group[k] == group[v]) return false;
-      const Eigen::Vector2d local =
-          Eigen::Rotation2Dd(-o.yaw) * (d.center.head<2>() - o.center.head<2>());
-      return std::abs(local.x()) <= 0.5 * o.size.x() + config_.duplicate_margin_m &&
-             std::abs(local.y()) <= 0.5 * o.size.y() + config_.duplicate_margin_m;
+      return group[k] != group[v] && insideFootprint(d.center.head<2>(), detections[k], config_.duplicate_margin_m);
     });
     if (duplicate)
       ++skipped.duplicate;
@@ -229,6 +234,7 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
     if (assignment[u] >= 0) trajectory_of[assignment[u]] = u;
 
   std::vector<char> keep(V, 1);
+  std::vector<int> trajectory_index(V, -1);  // the trajectory each kept association extended or started
   for (int v = 0; v < V; ++v) {
     Association& a = out.associations[v];
     if (trajectory_of[v] < 0 && a.box_lidar.score < policy_of[v]->min_score) {
@@ -263,26 +269,7 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
     // Preliminary static/dynamic guess from the motion over the window (III-D).
     tr.displacement = windowDisplacement(tr.window);
     tr.is_dynamic = tr.displacement > config_.dynamic_displacement_m;
-    // The class over the window: a track moving faster than its class can is not of it.
-    if (tr.relabelled_as.empty() && !tr.suppressed) {
-      const auto rule = config_.plausibility.find(config_.classes[policy].name);
-      const double span = tr.window.back().time_s - tr.window.front().time_s;
-      if (rule != config_.plausibility.end() && span >= rule->second.min_span_s &&
-          tr.displacement / span > rule->second.max_speed_mps) {
-        if (rule->second.too_fast_type.empty()) {
-          tr.suppressed = true;
-          ++out.class_decisions.suppressed_too_fast;
-        } else {
-          tr.relabelled_as = rule->second.too_fast_type;
-          ++out.class_decisions.relabelled_too_fast;
-        }
-      }
-    }
-    if (!tr.relabelled_as.empty()) {
-      a.box_lidar.type = a.box_world.type = tr.relabelled_as;
-      a.relabelled = true;
-    }
-    a.suppressed = tr.suppressed;
+    trajectory_index[v] = u;
 
     tr.last_box = a.box_world;
     a.track_id = tr.id;
@@ -292,6 +279,7 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
     a.status = tr.lifecycle.status();
     a.confidence = tr.lifecycle.confidence();
   }
+  decideClasses(trajectory_index, out);
   std::vector<Association> kept;
   for (int v = 0; v < V; ++v)
     if (keep[v]) kept.push_back(std::move(out.associations[v]));
@@ -321,6 +309,68 @@ FrameAssociations TrajectoryAssociator::associate(int frame, double time_s, cons
   }
   out.num_active_tracks = static_cast<int>(trajectories_.size());
   return out;
+}
+
+void TrajectoryAssociator::decideClasses(const std::vector<int>& trajectory_of_association, FrameAssociations& out) {
+  const std::vector<int>& tr_of = trajectory_of_association;
+  const int V = static_cast<int>(out.associations.size());
+  auto ruleOf = [&](const Trajectory& tr) -> const ClassPlausibility* {
+    if (tr.classDecided()) return nullptr;  // decided once, for the rest of its life
+    const auto rule = config_.plausibility.find(config_.classes[tr.policy].name);
+    return rule == config_.plausibility.end() ? nullptr : &rule->second;
+  };
+  // First where each box of a yielding class sits, against the classes as they stood before this
+  // frame's decisions (so the order of the detections does not matter): inside the box of a
+  // track of another class group, or of one re-labelled (a cyclist tracked from pedestrian boxes).
+  for (int v = 0; v < V; ++v) {
+    if (tr_of[v] < 0) continue;
+    Trajectory& tr = trajectories_[tr_of[v]];
+    const ClassPlausibility* rule = ruleOf(tr);
+    if (!rule || !rule->yields_to_other_classes) continue;
+    const Eigen::Vector2d centre = out.associations[v].box_world.center.head<2>();
+    bool on_other = false;
+    for (int w = 0; w < V && !on_other; ++w) {
+      if (w == v || tr_of[w] < 0) continue;
+      const Trajectory& other = trajectories_[tr_of[w]];
+      if (other.policy == tr.policy && other.relabelled_as == tr.relabelled_as) continue;
+      on_other = insideFootprint(centre, out.associations[w].box_world, 0.0);
+    }
+    tr.window.back().on_other_class = on_other;
+  }
+  // Then the decisions, over the window.
+  for (int v = 0; v < V; ++v) {
+    if (tr_of[v] < 0) continue;
+    Trajectory& tr = trajectories_[tr_of[v]];
+    if (const ClassPlausibility* rule = ruleOf(tr)) {
+      const double span = tr.window.back().time_s - tr.window.front().time_s;
+      const auto on_other = std::count_if(tr.window.begin(), tr.window.end(),
+                                          [](const TrajectoryPoint& p) { return p.on_other_class; });
+      if (span < rule->min_span_s) {
+        // not yet enough of a window to judge
+      } else if (rule->yields_to_other_classes && 2 * on_other >= static_cast<long>(tr.window.size())) {
+        // Another track's object seen a second time; first, so that a second "pedestrian" on a
+        // cyclist does not become a second cyclist by its speed.
+        tr.suppressed = true;
+        ++out.class_decisions.suppressed_on_other_class;
+      } else if (tr.displacement / span > rule->max_speed_mps) {
+        // Faster than its class can move: not of it.
+        if (rule->too_fast_type.empty()) {
+          tr.suppressed = true;
+          ++out.class_decisions.suppressed_too_fast;
+        } else {
+          tr.relabelled_as = rule->too_fast_type;
+          ++out.class_decisions.relabelled_too_fast;
+        }
+      }
+    }
+    Association& a = out.associations[v];
+    if (!tr.relabelled_as.empty()) {
+      a.box_lidar.type = a.box_world.type = tr.relabelled_as;
+      tr.last_box.type = tr.relabelled_as;
+      a.relabelled = true;
+    }
+    a.suppressed = tr.suppressed;
+  }
 }
 
 }  // namespace dlslot::tracker

@@ -24,15 +24,22 @@ Predictor predictorFromName(const std::string& name);  // "polynomial" | "last_p
 // Truck; pedestrian = Pedestrian, Person_sitting; cyclist = Cyclist.
 std::vector<ClassPolicy> defaultClassPolicies();
 
-// What a class's objects can plausibly do over a window, beyond a single detector vote: a track
-// moving faster than max_speed_mps (its least-squares velocity over the window, once the window
-// spans min_span_s) is not of this class. It is then re-labelled as `too_fast_type` (e.g. a
-// "pedestrian" at cyclist speed is a cyclist the detector has no class file for), or its rows are
-// suppressed when that is empty; the decision sticks to the track.
+// What a class's objects can plausibly do over a window, beyond a single detector vote; each
+// decision is taken once the window spans min_span_s and sticks to the track:
+// - a track moving faster than max_speed_mps (its least-squares velocity over the window) is not
+//   of this class. It is re-labelled as `too_fast_type` (e.g. a "pedestrian" at cyclist speed is
+//   a cyclist the detector has no class file for), or suppressed when that is empty;
+// - with yields_to_other_classes, a track whose boxes sat inside the box of a track of another
+//   class (another class group, or one re-labelled) at half or more of its window's observations
+//   is that other object seen a second time by the detector (a pedestrian box on a cyclist that
+//   is already tracked as one, or on a car): suppressed. The same rule as the duplicate
+//   suppression of one frame (a detection centred inside another's footprint), held over the
+//   window, so it also covers the frames where the other class's box was the less confident one.
 struct ClassPlausibility {
   double max_speed_mps = std::numeric_limits<double>::infinity();
   std::string too_fast_type;
   double min_span_s = 0.5;
+  bool yields_to_other_classes = false;
 };
 
 struct AssociatorConfig {
@@ -66,10 +73,11 @@ struct Trajectory {
   bool is_dynamic = false;
   int policy = -1;  // index into AssociatorConfig::classes: the class group it is gated with
   TrackLifecycle lifecycle{0.0, ClassPolicy{}};
-  // Set once the track moved faster than its class allows (ClassPlausibility): the type it is
-  // reported as from then on; "" with `suppressed` when its rows are not reported at all.
+  // Set once the window's evidence overruled the track's class (ClassPlausibility): the type it
+  // is reported as from then on; "" with `suppressed` when its rows are not reported at all.
   std::string relabelled_as;
   bool suppressed = false;
+  bool classDecided() const { return suppressed || !relabelled_as.empty(); }
 };
 
 // The outcome for one detection of the frame.
@@ -114,6 +122,13 @@ struct SkippedDetections {
 struct ClassDecisions {
   int relabelled_too_fast = 0;
   int suppressed_too_fast = 0;
+  int suppressed_on_other_class = 0;
+  ClassDecisions& operator+=(const ClassDecisions& o) {
+    relabelled_too_fast += o.relabelled_too_fast;
+    suppressed_too_fast += o.suppressed_too_fast;
+    suppressed_on_other_class += o.suppressed_on_other_class;
+    return *this;
+  }
 };
 
 struct FrameAssociations {
@@ -155,6 +170,9 @@ class TrajectoryAssociator {
   Gate gateOf(const Trajectory& tr, const Eigen::Vector3d& predicted, bool initialized, double time_s) const;
   // The position a trajectory predicts for time_s, and whether that prediction makes it initialized.
   Eigen::Vector3d predict(const Trajectory& tr, double time_s, bool* initialized) const;
+  // The rules of ClassPlausibility on the trajectories that took the frame's detections
+  // (`trajectory_of_association[i]` for out.associations[i], -1 when it took none).
+  void decideClasses(const std::vector<int>& trajectory_of_association, FrameAssociations& out);
 
   AssociatorConfig config_;
   std::vector<Trajectory> trajectories_;

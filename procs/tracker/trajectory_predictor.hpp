@@ -13,6 +13,9 @@ struct TrajectoryPoint {
   int frame = 0;
   double time_s = 0.0;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  // The box sat inside the box of a track of another class at this frame (class plausibility,
+  // trajectory_associator.hpp); the prediction does not use it.
+  bool on_other_class = false;
 };
 
 struct Prediction {

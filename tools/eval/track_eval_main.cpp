@@ -12,6 +12,7 @@
 //   the confidences (a threshold set beforehand would cut their recall axis short).
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <cstdio>
 #include <filesystem>
@@ -93,6 +94,20 @@ std::vector<Pose> perturbed(std::vector<Pose> poses, double sigma_m, double sigm
   return poses;
 }
 
+// Each ego pose moved by a random walk: translation steps N(0, step_m) along x and y, summed frame
+// by frame (a slow drift of the GPS/INS solution, as parked cars spread up to ~2 m in the world
+// frame over a KITTI sequence). Seeded.
+std::vector<Pose> drifted(std::vector<Pose> poses, double step_m, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, step_m);
+  Eigen::Vector3d drift = Eigen::Vector3d::Zero();
+  for (Pose& X : poses) {
+    drift += Eigen::Vector3d(n(rng), n(rng), 0.0);
+    X.translation() += drift;
+  }
+  return poses;
+}
+
 // Every detection as a track of its own: what the detections alone can recall (the ceiling no
 // tracker that reports detected boxes can pass).
 std::vector<kitti::LabelRow> detectionRows(const kitti::SequenceReader& reader) {
@@ -112,6 +127,7 @@ double recallOf(const KittiCounts& c) { return c.labels > 0 ? 1.0 - static_cast<
 
 int run(int argc, char** argv) {
   std::string root, poses, sequences_arg, out, config = kDefaultConfig, output, pose_noise, ab3dmot;
+  double pose_drift = 0;
   std::vector<std::string> detections;
   double min_iou = 0.25, frame_period = 0.1;
   bool quiet = false;
@@ -130,6 +146,8 @@ int run(int argc, char** argv) {
   cl.option("--frame-period", &frame_period, "seconds per frame (default 0.1)");
   cl.option("--pose-noise", &pose_noise, "M,DEG: perturb every ego pose by N(0, M) metres in x and y and N(0, DEG) "
                                          "degrees of yaw, independently per frame (a robustness test; seeded)");
+  cl.option("--pose-drift", &pose_drift, "M: add a random walk of N(0, M) metres a frame in x and y to the ego poses "
+                                         "(a slow drift of the solution; a robustness test; seeded)");
   cl.option("--ab3dmot-eval", &ab3dmot, "a checkout of xinshuoweng/AB3DMOT: also score OUT/data_all with its own "
                                         "scripts/KITTI/evaluate.py (scripts/ab3dmot-eval; several minutes) and "
                                         "print its numbers beside ours");
@@ -155,6 +173,8 @@ int run(int argc, char** argv) {
       throw std::invalid_argument("--pose-noise: expected M,DEG (two numbers >= 0), got '" + pose_noise + "'");
     noise_deg = std::strtod(v[1].c_str(), nullptr);
   }
+  if (!(pose_drift >= 0) || !std::isfinite(pose_drift))
+    throw std::invalid_argument("--pose-drift: expected metres >= 0, got " + std::to_string(pose_drift));
   if (!ab3dmot.empty() && !fs::exists(fs::path(ab3dmot) / "scripts" / "KITTI" / "evaluate.py"))
     throw std::invalid_argument("--ab3dmot-eval " + ab3dmot +
                                 ": no scripts/KITTI/evaluate.py there (expected a checkout of xinshuoweng/AB3DMOT)");
@@ -170,6 +190,8 @@ int run(int argc, char** argv) {
   std::map<std::string, std::map<std::string, KittiClassMetrics>> per_sequence;
   std::vector<std::string> notes;
   TimingStats association_ms;
+  tracker::ClassDecisions decisions;  // of the all-tracks run, over every sequence
+  int suppressed_rows = 0;
   ProgressLine progress("track-eval", static_cast<int>(sequences.size()));
   for (size_t i = 0; i < sequences.size(); ++i) {
     const std::string& s = sequences[i];
@@ -183,6 +205,10 @@ int run(int argc, char** argv) {
       ego = perturbed(std::move(ego), noise_m, noise_deg, 1000 + static_cast<unsigned>(i));
       pose_source += " perturbed by " + pose_noise;
     }
+    if (pose_drift > 0 && pose_source.rfind("no ego poses", 0) != 0) {
+      ego = drifted(std::move(ego), pose_drift, 2000 + static_cast<unsigned>(i));
+      pose_source += " drifting by " + std::to_string(pose_drift) + " m a frame";
+    }
     const tracker::OfflineResult r = tracker::associateSequence(reader, ego, cfg.associator, cfg.output);
     for (double ms : r.association_ms.samples()) association_ms.add(ms);
     kitti::writeTrackingLabels((fs::path(out) / "data" / (s + ".txt")).string(), r.tracks);
@@ -193,10 +219,17 @@ int run(int argc, char** argv) {
                   s.c_str(), reader.size(), reader.hasScans() ? "" : " (no scans)", pose_source.c_str(), r.detections,
                   r.skipped.total(), r.skipped.untracked_type, r.skipped.below_score, r.skipped.duplicate,
                   r.tracks.size(), r.outside_image);
-    notes.push_back(note);
     KittiSequence seq{s, kitti::readTrackingLabels(reader.paths().labels), r.tracks, {}};
     for (int f = 0; f < reader.size(); ++f) seq.frames.push_back(f);
     const tracker::OfflineResult r_all = tracker::associateSequence(reader, ego, sweep_cfg.associator, sweep_cfg.output);
+    // The class decisions of the window (ClassPlausibility), by reason, in the all-tracks run.
+    const tracker::ClassDecisions& c = r_all.class_decisions;
+    decisions += c;
+    suppressed_rows += r_all.suppressed_rows;
+    std::snprintf(note + std::strlen(note), sizeof note - std::strlen(note),
+                  "; tracks re-labelled too fast %d, suppressed too fast %d, suppressed on another class %d (%d rows)",
+                  c.relabelled_too_fast, c.suppressed_too_fast, c.suppressed_on_other_class, r_all.suppressed_rows);
+    notes.push_back(note);
     kitti::writeTrackingLabels((fs::path(out) / "data_all" / (s + ".txt")).string(), r_all.tracks);
     KittiSequence seq_all{s, seq.labels, r_all.tracks, seq.frames};
     for (const kitti::LabelRow& row : r_all.tracks)
@@ -250,6 +283,11 @@ int run(int argc, char** argv) {
     if (const auto d = ceiling.find(cls); d != ceiling.end())
       kv.emplace_back("tracking." + cls + ".recall_detections", recallOf(d->second.all));
   }
+  // The window's class decisions by reason (the all-tracks run, every sequence).
+  kv.emplace_back("class_decisions.relabelled_too_fast", decisions.relabelled_too_fast);
+  kv.emplace_back("class_decisions.suppressed_too_fast", decisions.suppressed_too_fast);
+  kv.emplace_back("class_decisions.suppressed_on_other_class", decisions.suppressed_on_other_class);
+  kv.emplace_back("class_decisions.suppressed_rows", suppressed_rows);
   kv.emplace_back("timing_ms.association.mean", association_ms.mean());
   kv.emplace_back("timing_ms.association.p95", association_ms.percentile(95));
   std::ofstream json(fs::path(out) / "metrics.json");

@@ -7,9 +7,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <deque>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -21,6 +23,23 @@ namespace {
 double seconds(const rusage& u) {
   return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
          1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+// CPU seconds (user + system) a running process has used so far, from /proc/PID/stat; -1 when
+// it cannot be read.
+double runningCpuSeconds(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // Fields after the command (which may hold spaces) start after its closing parenthesis;
+  // utime and stime are the 14th and 15th fields of the line, the 12th and 13th after it.
+  const auto close = text.rfind(')');
+  if (close == std::string::npos) return -1.0;
+  std::istringstream fields(text.substr(close + 2));
+  std::string skip;
+  for (int i = 0; i < 11; ++i) fields >> skip;
+  long long utime = 0, stime = 0;
+  if (!(fields >> utime >> stime)) return -1.0;
+  return static_cast<double>(utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
 }
 
 }  // namespace
@@ -89,12 +108,22 @@ int Supervisor::stop(const std::string& name, double grace_s, const std::functio
   c.reported = true;  // stopped on purpose: the caller gets the code
   if (!running(name)) return c.code;
   kill(c.pid, SIGINT);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(grace_s);
-  while (running(name) && std::chrono::steady_clock::now() < deadline) {
+  using Clock = std::chrono::steady_clock;
+  const auto grace = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(grace_s));
+  const auto hard_deadline = Clock::now() + 10 * grace;
+  auto worked = Clock::now(), checked = worked;
+  double cpu = runningCpuSeconds(c.pid);
+  while (running(name) && Clock::now() < std::min(worked + grace, hard_deadline)) {
     if (idle)
       idle();
     else
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (Clock::now() - checked > std::chrono::milliseconds(500)) {
+      checked = Clock::now();
+      const double now_cpu = runningCpuSeconds(c.pid);
+      if (now_cpu > cpu) worked = checked;
+      cpu = now_cpu;
+    }
   }
   if (running(name)) {
     kill(c.pid, SIGKILL);

@@ -31,8 +31,10 @@ class Supervisor {
   std::optional<Exit> reap();
   bool running(const std::string& name);
 
-  // SIGINT to `name`, SIGKILL after grace_s; returns its exit code (128 + signal when killed).
-  // `idle` (if given) is called repeatedly while waiting, instead of sleeping.
+  // SIGINT to `name`, SIGKILL once it has used no CPU for grace_s (or after ten graces whatever
+  // it does); returns its exit code (128 + signal when killed). A process still working when
+  // asked to stop (the renderer writing its backlog of images on a loaded machine) is finishing,
+  // not hung. `idle` (if given) is called repeatedly while waiting, instead of sleeping.
   int stop(const std::string& name, double grace_s = 5.0, const std::function<void()>& idle = {});
   // Stops every running child, newest first.
   void stopAll(double grace_s = 5.0);

@@ -50,6 +50,9 @@ struct ClassPolicy {
   // A confirmed track missed by the detector is still reported, at its predicted position, for
   // this many frames (<= max_misses): a detector blinks more often than an object vanishes.
   int output_coasting_frames = 0;
+  // Added to the score column of a track that moved over ground (tracker/track_evidence.hpp), in
+  // the detector's raw score units: motion as evidence that the track is a real object.
+  double moving_evidence = 0.0;
 
   void validate() const;  // std::invalid_argument naming the bad field
 };

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <random>
+#include <unordered_set>
 
 #include "mapper/loop_verifier.hpp"
 #include "mapper/map_output.hpp"
@@ -16,6 +17,7 @@
 #include "mapper/scan_context.hpp"
 #include "mapper/track_boxes.hpp"
 #include "mapper/voxel_map.hpp"
+#include "dlslot/voxel_key.hpp"
 
 using namespace dlslot;
 using namespace dlslot::mapper;
@@ -163,6 +165,30 @@ TEST(VoxelMap, VoxelsFollowTheirKeyframesWhenTheGraphMovesThem) {
   for (Eigen::Index i = 0; i < c.cols(); ++i) moved += std::abs(c(1, i) - 2.05f) < 1e-4;
   EXPECT_EQ(moved, 2);
   EXPECT_EQ(map.size(), 4u);
+}
+
+TEST(VoxelMap, CountsTheSameCellsAsVoxelKeyOnBothSidesOfTheOrigin) {
+  // Blocks of 8 x 8 x 8 voxels: cells on either side of 0 and of a block edge (+-1.6 m) must stay
+  // apart; a voxel keeps its first point's intensity.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-4.0, 4.0);
+  std::vector<Eigen::Vector3d> pts;
+  for (int i = 0; i < 20000; ++i) pts.emplace_back(u(rng), u(rng), 0.25 * u(rng));
+  std::unordered_set<uint64_t> keys;
+  for (const Eigen::Vector3d& p : pts) keys.insert(voxelKey(p, 0.2));
+  VoxelMap map(0.2);
+  map.insert(0, Pose::Identity(), toCloud(pts));
+  EXPECT_EQ(map.size(), keys.size());
+  const PointCloud c = map.cloud();
+  std::unordered_set<uint64_t> out;
+  for (Eigen::Index i = 0; i < c.cols(); ++i) {
+    out.insert(voxelKey(c.col(i).head<3>().cast<double>(), 0.2));
+    EXPECT_FLOAT_EQ(c(3, i), 0.5f);
+  }
+  EXPECT_EQ(out, keys);  // one point per voxel, each in its own cell
+  VoxelMap two(0.2);     // -0.1 and 0.1 are different cells; -1.61 and -1.59 different blocks
+  two.insert(0, Pose::Identity(), toCloud({{-0.1, -0.1, -0.1}, {0.1, 0.1, 0.1}, {-1.61, 0, 0}, {-1.59, 0, 0}, {0.05, 0.05, 0.05}}));
+  EXPECT_EQ(two.size(), 4u);
 }
 
 TEST(PoseGraph, ALoopEdgeTakesOutTheDriftOfASquare) {

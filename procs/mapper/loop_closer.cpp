@@ -11,8 +11,12 @@ PointCloud voxelDownsample(const PointCloud& points, double voxel_m) {
   std::unordered_set<uint64_t> seen;
   seen.reserve(points.cols());
   std::vector<Eigen::Index> keep;
-  for (Eigen::Index i = 0; i < points.cols(); ++i)
-    if (seen.insert(voxelKey(points.col(i).head<3>().cast<double>(), voxel_m)).second) keep.push_back(i);
+  uint64_t previous = ~uint64_t{0};  // consecutive points of a ring often share a cell: one look-up for the run
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const uint64_t key = voxelKey(points.col(i).head<3>().cast<double>(), voxel_m);
+    if (key != previous && seen.insert(key).second) keep.push_back(i);
+    previous = key;
+  }
   PointCloud out(4, static_cast<Eigen::Index>(keep.size()));
   for (size_t k = 0; k < keep.size(); ++k) out.col(static_cast<Eigen::Index>(k)) = points.col(keep[k]);
   return out;
@@ -125,39 +129,48 @@ void LoopCloser::process(KeyframeInput in) {
       }
     }
     if (!(best >= 0 && best_match.distance <= config_.max_descriptor_distance)) best = -1;
-    // A nearest-keyframe candidate is verified once every few keyframes (the query moves on by
+    // A nearest-keyframe candidate is verified every other keyframe (the query moves on by
     // metres between them; verification is the costly part).
-    const int candidate = best >= 0 ? best : (nearest >= 0 && id % 5 == 0 ? nearest : -1);
+    const int candidate = best >= 0 ? best : (nearest >= 0 && id % 2 == 0 ? nearest : -1);
     if (candidate >= 0) {
       const Keyframe& c = keyframes_[candidate];
       const Pose T_c = graph_.pose(candidate);
       const Pose prior = T_c.inverse() * T_q;
-      // The match side is a local map: the candidate and its neighbours in its frame.
-      const int lo = std::max(0, candidate - config_.submap_keyframes), hi = std::min(id - 1, candidate + config_.submap_keyframes);
-      std::vector<PointCloud> parts;
-      Eigen::Index n = 0;
-      for (int j = lo; j <= hi; ++j) {
-        if (q.path_m - keyframes_[j].path_m < config_.min_separation_m) break;
-        const Pose T_cj = T_c.inverse() * graph_.pose(j);
-        PointCloud part = keyframes_[j].cloud;
-        for (Eigen::Index i = 0; i < part.cols(); ++i) part.col(i).head<3>() = (T_cj * part.col(i).head<3>().cast<double>()).cast<float>();
-        n += part.cols();
-        parts.push_back(std::move(part));
-      }
-      PointCloud submap(4, n);
-      n = 0;
-      for (const PointCloud& part : parts) {
-        submap.middleCols(n, part.cols()) = part;
-        n += part.cols();
-      }
-      submap = voxelDownsample(submap, config_.registration_voxel_m);
+      // Both sides are local maps, each in its own keyframe's frame: the candidate and its
+      // neighbours either side, the query and the keyframes just before it. A place passed again
+      // tens of metres off (urban-loop ends 35 m short of its start) overlaps only at range, where
+      // one scan is sparse: the neighbours give the registration more of the shared street.
+      auto localMap = [&](int centre, int lo, int hi) {
+        const Pose T_centre_inv = graph_.pose(centre).inverse();
+        std::vector<PointCloud> parts;
+        Eigen::Index n = 0;
+        for (int j = lo; j <= hi; ++j) {
+          const Pose T_cj = T_centre_inv * graph_.pose(j);
+          PointCloud part = keyframes_[j].cloud;
+          for (Eigen::Index i = 0; i < part.cols(); ++i)
+            part.col(i).head<3>() = (T_cj * part.col(i).head<3>().cast<double>()).cast<float>();
+          n += part.cols();
+          parts.push_back(std::move(part));
+        }
+        PointCloud out(4, n);
+        n = 0;
+        for (const PointCloud& part : parts) {
+          out.middleCols(n, part.cols()) = part;
+          n += part.cols();
+        }
+        return voxelDownsample(out, config_.registration_voxel_m);
+      };
+      int hi = std::min(id - 1, candidate + config_.submap_keyframes);
+      while (hi > candidate && q.path_m - keyframes_[hi].path_m < config_.min_separation_m) --hi;
+      const PointCloud submap = localMap(candidate, std::max(0, candidate - config_.submap_keyframes), hi);
+      const PointCloud query_map = localMap(id, std::max(hi + 1, id - config_.submap_keyframes), id);
       LoopEvent e;
       e.query_keyframe = id;
       e.match_keyframe = candidate;
       e.query_frame = q.frame;
       e.match_frame = c.frame;
       e.descriptor_distance = compare(q.descriptor, c.descriptor).distance;
-      e.verdict = verifyLoop(q.cloud, submap, prior, q.path_m - c.path_m, config_);
+      e.verdict = verifyLoop(query_map, submap, prior, q.path_m - c.path_m, config_);
       if (e.verdict.accepted) {
         Vector6d sigma;
         sigma << config_.loop_sigma_t, config_.loop_sigma_t, config_.loop_sigma_t, config_.loop_sigma_r,

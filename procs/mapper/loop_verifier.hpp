@@ -1,8 +1,10 @@
 // Verifying a loop candidate: the two keyframes' clouds registered (PCL's generalized ICP,
 // Segal et al. 2009), then a strict acceptance test. A false loop bends the whole trajectory, a
 // missed one only leaves drift, so a candidate must pass all of:
-//   1. overlap: most of the query's structure (points off the ground) lies within
-//      inlier_distance of the match after alignment, with a small RMS distance;
+//   1. overlap: most of the query's structure (points off the ground) that falls within
+//      overlap_radius_m of the match keyframe (where the match side sees densely: a place passed
+//      again tens of metres away overlaps only there) lies within inlier_distance of the match
+//      after alignment, with a small RMS distance;
 //   2. drift bound: the registration moves the query at most 1 m + max_drift_fraction x the path
 //      driven since the match (and 2 deg + 1 deg per 100 m) away from where the odometry puts it:
 //      anything farther is not drift but a wrong place;

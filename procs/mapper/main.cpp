@@ -4,6 +4,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include <algorithm>
+#include <cstring>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "dlslot/convert.hpp"
 #include "dlslot/frame_joiner.hpp"
 #include "dlslot/lcm_log.hpp"
+#include "dlslot/message_guard.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/point_cloud_t.hpp"
 #include "dlslot/progress.hpp"
@@ -25,7 +27,48 @@ using namespace dlslot::mapper;
 
 namespace {
 
-using Joiner = FrameJoiner<PointCloud, MapperInput>;
+// A LIDAR_SCAN as it arrived (its layout checked): its points are decoded only when the scan
+// becomes a keyframe, which is known once its SLOT_STATE is there. At 10 m/s and a keyframe every
+// metre or two, most scans are never decoded.
+struct RawScan {
+  std::vector<uint8_t> bytes;
+};
+using Joiner = FrameJoiner<RawScan, MapperInput>;
+
+// The frame index of a LIDAR_SCAN whose layout checked: after the type hash and the utime (LCM is big-endian).
+int scanFrame(const uint8_t* data) {
+  uint32_t v;
+  std::memcpy(&v, data + 16, 4);
+  return static_cast<int>(__builtin_bswap32(v));
+}
+
+// Checks a scan's layout and frame order; returns the frame, or -1 when refused (counted in `status`).
+int acceptScan(const uint8_t* data, size_t size, FrameOrder& order, ProcessStatus& status, const std::string& channel,
+               const std::string& where) {
+  Refusal why = checkLayout(static_cast<const point_cloud_t*>(nullptr), data, size);
+  const int frame = why ? -1 : scanFrame(data);
+  if (!why) why = order.accept(frame);
+  if (why) {
+    status.refused(channel, why, where);
+    return -1;
+  }
+  return frame;
+}
+
+// Hands a joined frame to the mapper, decoding (and checking) its scan only when it is a keyframe.
+// A keyframe whose points do not decode is refused and the frame skipped, as a missing scan would be.
+bool feed(Mapper& mapper, Joiner::Joined& j, ProcessStatus& status, const std::string& channel) {
+  if (mapper.needsScan(j.b->pose)) {
+    point_cloud_t m;
+    if (const Refusal why = decodeChecked(j.a->bytes.data(), j.a->bytes.size(), &m)) {
+      status.refused(channel, why, "frame " + std::to_string(j.frame) + ": ");
+      return false;
+    }
+    j.b->scan = fromMsg(m);
+  }
+  mapper.add(*j.b);
+  return true;
+}
 
 double nowSeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -61,32 +104,31 @@ int runOffline(const MapperConfig& config, const Channels& channels, const std::
   Mapper mapper(config, /*threaded=*/false);
   Joiner joiner(std::numeric_limits<double>::infinity());
   ProcessStatus guard("mapper");
+  LogEnvelopes envelopes(in_path);  // every event verified as it would be live (lcm_log.hpp)
   std::map<std::string, FrameOrder> order;
   ProgressLine progress("mapper " + fs::path(in_path).filename().string() + " (% of the log)", 100);
   int frames = 0, missing = 0;
   auto handle = [&](std::vector<Joiner::Joined> ready) {
     for (Joiner::Joined& j : ready) {
-      if (!j.a || !j.b) {
+      if (!j.a || !j.b || !feed(mapper, j, guard, channels.scan)) {
         ++missing;
         continue;
       }
-      j.b->scan = std::move(*j.a);
-      mapper.add(*j.b);
       ++frames;
     }
   };
   int64_t index = 0;
-  for (; const lcm::LogEvent* ev = nextLogEvent(in, in_path); ++index) {
-    const bool scan = ev->channel == channels.scan, slot = ev->channel == channels.slot_state;
+  for (; const lcm::LogEvent* raw = nextLogEvent(in, in_path); ++index) {
+    const bool scan = raw->channel == channels.scan, slot = raw->channel == channels.slot_state;
     if (!scan && !slot) continue;
     const std::string where = in_path + ": event " + std::to_string(index) + ": ";
+    const lcm::LogEvent* ev = envelopes.open(*raw, guard, where);
+    if (!ev) continue;
     const size_t size = static_cast<size_t>(std::max(ev->datalen, 0));
     if (scan) {
-      point_cloud_t m;
-      Refusal why = decodeChecked(ev->data, size, &m);
-      if (!why) why = order[ev->channel].accept(m.frame);
-      if (why) guard.refused(ev->channel, why, where);
-      else joiner.addA(m.frame, fromMsg(m), 0.0);
+      const uint8_t* data = static_cast<const uint8_t*>(ev->data);
+      const int frame = acceptScan(data, size, order[ev->channel], guard, ev->channel, where);
+      if (frame >= 0) joiner.addA(frame, RawScan{std::vector<uint8_t>(data, data + size)}, 0.0);
     } else {
       slot_state_t m;
       Refusal why = decodeChecked(ev->data, size, &m);
@@ -122,8 +164,7 @@ int runLive(const MapperConfig& config, const Channels& channels, const NodeOpti
       try {
         const Pose slot_pose = j.b->pose;
         const int64_t utime = j.b->utime;
-        j.b->scan = std::move(*j.a);
-        mapper.add(*j.b);
+        if (!feed(mapper, j, node.status(), channels.scan)) continue;
         node.publish(config.channel, mapStateMsg(mapper, j.frame, utime, slot_pose, mapper.loops().takeEvents()));
         node.status().frameDone(j.frame, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         node.status().set("keyframes", static_cast<int64_t>(mapper.keyframes().size()));
@@ -135,9 +176,16 @@ int runLive(const MapperConfig& config, const Channels& channels, const NodeOpti
       }
     }
   };
-  node.subscribeFrames<point_cloud_t>(channels.scan, [&](const point_cloud_t& m) {
-    if (!joiner.addA(m.frame, fromMsg(m), nowSeconds()))
-      node.status().warn("LIDAR_SCAN of frame " + std::to_string(m.frame) + " arrived after the frame was released");
+  // The scans raw (their points decoded for keyframes only); SLOT_STATE's subscription counts the
+  // frames received.
+  FrameOrder scan_order;
+  node.onRestart([&](const run_event_t&) { scan_order.reset(); });
+  node.subscribeRaw(channels.scan, [&](const lcm::ReceiveBuffer& rbuf) {
+    const uint8_t* data = static_cast<const uint8_t*>(rbuf.data);
+    const int frame = acceptScan(data, rbuf.data_size, scan_order, node.status(), channels.scan, "");
+    if (frame < 0) return;
+    if (!joiner.addA(frame, RawScan{std::vector<uint8_t>(data, data + rbuf.data_size)}, nowSeconds()))
+      node.status().warn("LIDAR_SCAN of frame " + std::to_string(frame) + " arrived after the frame was released");
     handleReady();
   });
   node.subscribeFrames<slot_state_t>(channels.slot_state, [&](const slot_state_t& m) {
@@ -149,10 +197,7 @@ int runLive(const MapperConfig& config, const Channels& channels, const NodeOpti
   const int code = node.run();
   // Stopped (SIGINT/SIGTERM): what is still waiting goes in, then the files.
   for (Joiner::Joined& j : joiner.flush())
-    if (j.a && j.b) {
-      j.b->scan = std::move(*j.a);
-      mapper.add(*j.b);
-    }
+    if (j.a && j.b) feed(mapper, j, node.status(), channels.scan);
   mapper.finish();
   const std::vector<std::string> files = out.empty() ? std::vector<std::string>{} : writeMapOutputs(out, mapper);
   printSummary(mapper, out, files);

@@ -12,16 +12,17 @@ Mapper::Mapper(const MapperConfig& config, bool threaded)
       removed_(config.map_voxel_m),
       loops_(std::make_unique<LoopCloser>(config.loop, threaded)) {}
 
+bool Mapper::needsScan(const Pose& pose) const {
+  if (!last_keyframe_pose_) return true;
+  const Pose d = last_keyframe_pose_->inverse() * pose;
+  return d.translation().norm() >= config_.keyframe_distance_m ||
+         Eigen::AngleAxisd(d.rotation()).angle() * 180.0 / M_PI >= config_.keyframe_angle_deg;
+}
+
 void Mapper::add(const MapperInput& in) {
   frames_[in.frame] = {in.utime, in.pose};
   boxes_.add(in.frame, in.utime * 1e-6, in.tracks);
-  bool keyframe = !last_keyframe_pose_;
-  if (!keyframe) {
-    const Pose d = last_keyframe_pose_->inverse() * in.pose;
-    keyframe = d.translation().norm() >= config_.keyframe_distance_m ||
-               Eigen::AngleAxisd(d.rotation()).angle() * 180.0 / M_PI >= config_.keyframe_angle_deg;
-  }
-  if (keyframe) {
+  if (needsScan(in.pose)) {
     last_keyframe_pose_ = in.pose;
     Pending p{in.frame, in.utime, in.pose, PointCloud(4, in.scan.cols())};
     Eigen::Index n = 0;
@@ -53,22 +54,31 @@ void Mapper::finish() {
 void Mapper::commit(Pending& p) {
   const auto start = std::chrono::steady_clock::now();
   const Pose lidar_from_world = p.pose.inverse();
-  std::vector<Box> boxes = boxes_.removalBoxes(p.frame, p.utime * 1e-6);
-  std::vector<double> reach;  // a box's half diagonal in the ground plane: a cheap first test
-  for (Box& b : boxes) {
-    b = b.transformed(lidar_from_world);
-    reach.push_back(0.5 * b.size.head<2>().norm());
+  // The removal boxes in the lidar frame, with their heading's sine and cosine and the radius of
+  // their footprint worked out once: the test runs for every point of the keyframe against every
+  // box (Box::contains's test, in float, after a cheap footprint-circle rejection).
+  struct Cut {
+    Eigen::Vector3f center, half;
+    float c, s, reach2;
+  };
+  std::vector<Cut> cuts;
+  for (const Box& world_box : boxes_.removalBoxes(p.frame, p.utime * 1e-6)) {
+    const Box b = world_box.transformed(lidar_from_world);
+    const float reach = 0.5f * static_cast<float>(b.size.head<2>().norm());
+    cuts.push_back({b.center.cast<float>(), 0.5f * b.size.cast<float>(), static_cast<float>(std::cos(b.yaw)),
+                    static_cast<float>(std::sin(b.yaw)), reach * reach});
   }
   PointCloud kept(4, p.scan.cols()), gone(4, p.scan.cols());
   Eigen::Index nk = 0, ng = 0;
   for (Eigen::Index i = 0; i < p.scan.cols(); ++i) {
-    const Eigen::Vector3d q = p.scan.col(i).head<3>().cast<double>();
     bool inside = false;
-    for (size_t k = 0; k < boxes.size(); ++k)
-      if ((q.head<2>() - boxes[k].center.head<2>()).squaredNorm() <= reach[k] * reach[k] && boxes[k].contains(q)) {
-        inside = true;
-        break;
-      }
+    for (const Cut& k : cuts) {
+      const Eigen::Vector3f d = p.scan.col(i).head<3>() - k.center;
+      if (d.head<2>().squaredNorm() > k.reach2) continue;
+      inside = std::abs(k.c * d.x() + k.s * d.y()) <= k.half.x() && std::abs(-k.s * d.x() + k.c * d.y()) <= k.half.y() &&
+               std::abs(d.z()) <= k.half.z();
+      if (inside) break;
+    }
     (inside ? gone.col(ng++) : kept.col(nk++)) = p.scan.col(i);
   }
   kept.conservativeResize(4, nk);

@@ -20,7 +20,7 @@ namespace dlslot::mapper {
 struct MapperInput {
   int frame = 0;
   int64_t utime = 0;
-  PointCloud scan;                    // lidar frame
+  PointCloud scan;                    // lidar frame (may be empty when !needsScan(pose))
   Pose pose = Pose::Identity();       // T_world_lidar (SLOT_STATE ego pose)
   std::vector<TrackSnapshot> tracks;  // world frame
 };
@@ -38,6 +38,9 @@ class Mapper {
   // threaded: loop closure on its own thread (live); else inline (offline, reproducible).
   Mapper(const MapperConfig& config, bool threaded);
 
+  // Whether a scan at `pose` (T_world_lidar) becomes a keyframe: only then does add() read its
+  // points, so a caller may leave MapperInput::scan empty (and not decode it) otherwise.
+  bool needsScan(const Pose& pose) const;
   void add(const MapperInput& in);
   // Takes in the keyframes still waiting for their removal decision and waits for loop closure.
   void finish();

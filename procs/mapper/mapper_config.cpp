@@ -52,8 +52,11 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
   l.get("search_radius_m", L.search_radius_m);
   l.get("max_descriptor_distance", L.max_descriptor_distance);
   l.get("registration_voxel_m", L.registration_voxel_m);
+  l.get("coarse_correspondence_m", L.coarse_correspondence_m);
   l.get("max_correspondence_m", L.max_correspondence_m);
+  l.get("fine_correspondence_m", L.fine_correspondence_m);
   l.get("submap_keyframes", L.submap_keyframes);
+  l.get("overlap_radius_m", L.overlap_radius_m);
   l.get("inlier_distance_m", L.inlier_distance_m);
   l.get("min_inlier_ratio", L.min_inlier_ratio);
   l.get("max_rmse_m", L.max_rmse_m);
@@ -71,8 +74,11 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
                              {"search_radius_m", L.search_radius_m},
                              {"max_descriptor_distance", L.max_descriptor_distance},
                              {"registration_voxel_m", L.registration_voxel_m},
+                             {"coarse_correspondence_m", L.coarse_correspondence_m},
                              {"max_correspondence_m", L.max_correspondence_m},
+                             {"fine_correspondence_m", L.fine_correspondence_m},
                              {"inlier_distance_m", L.inlier_distance_m},
+                             {"overlap_radius_m", L.overlap_radius_m},
                              {"min_inlier_ratio", L.min_inlier_ratio},
                              {"max_rmse_m", L.max_rmse_m},
                              {"ambiguity_shift_m", L.ambiguity_shift_m},

@@ -13,9 +13,11 @@ struct LoopConfig {
   double max_radius_m = 50.0;
   double min_separation_m = 100.0, search_radius_m = 40.0;
   double max_descriptor_distance = 0.4;
-  double registration_voxel_m = 0.5, max_correspondence_m = 2.0;
+  double registration_voxel_m = 0.5, coarse_correspondence_m = 6.0, max_correspondence_m = 2.0,
+         fine_correspondence_m = 0.6;
   int submap_keyframes = 10;  // the match side of a verification: the candidate and this many keyframes either side
-  double inlier_distance_m = 0.3, min_inlier_ratio = 0.4, max_rmse_m = 0.15;
+  double overlap_radius_m = 30.0;
+  double inlier_distance_m = 0.3, min_inlier_ratio = 0.4, max_rmse_m = 0.25;
   double max_drift_fraction = 0.03;
   double ambiguity_shift_m = 4.0, ambiguity_ratio = 0.9;
   double odometry_sigma_t = 0.02, odometry_sigma_r = 0.002;

@@ -156,10 +156,11 @@ TEST(TrackBoxes, MovingTracksAreFollowedThroughMissesAndParkedOnesKeptUnlessMova
 TEST(VoxelMap, VoxelsFollowTheirKeyframesWhenTheGraphMovesThem) {
   VoxelMap map(0.2);
   const PointCloud pts = toCloud({{1.05, 0.05, 0.05}, {1.06, 0.06, 0.06}, {5.05, 0.05, 0.05}});
-  map.insert(0, Pose::Identity(), pts);
-  map.insert(1, poseXYYaw(10, 0, 0), pts);
-  EXPECT_EQ(map.size(), 4u);  // the first two points share a voxel
-  map.repose({Pose::Identity(), poseXYYaw(10, 2, 0)});
+  EXPECT_EQ(map.insert(0, Pose::Identity(), pts), 2u);  // the first two points share a voxel
+  EXPECT_EQ(map.insert(1, poseXYYaw(10, 0, 0), pts), 2u);
+  EXPECT_EQ(map.insert(2, poseXYYaw(10, 0, 0), pts), 0u);  // a place already held adds nothing
+  EXPECT_EQ(map.size(), 4u);
+  map.repose({Pose::Identity(), poseXYYaw(10, 2, 0), poseXYYaw(10, 2, 0)});
   const PointCloud c = map.cloud();
   int moved = 0;
   for (Eigen::Index i = 0; i < c.cols(); ++i) moved += std::abs(c(1, i) - 2.05f) < 1e-4;

@@ -83,6 +83,7 @@ void LoopCloser::process(KeyframeInput in) {
   kf.odometry = in.odometry;
   kf.cloud = voxelDownsample(in.points, config_.registration_voxel_m);
   kf.descriptor = makeScanContext(kf.cloud, sc_params_);
+  kf.candidate = in.keep_cloud;
   const int id = static_cast<int>(keyframes_.size());
   if (id > 0) {
     const Keyframe& prev = keyframes_.back();
@@ -116,6 +117,7 @@ void LoopCloser::process(KeyframeInput in) {
     for (int j = 0; j < id; ++j) {
       const Keyframe& c = keyframes_[j];
       if (q.path_m - c.path_m < config_.min_separation_m) break;  // path_m grows with j
+      if (!c.candidate) continue;
       const double d = (graph_.pose(j).translation() - T_q.translation()).norm();
       if (d > config_.search_radius_m) continue;
       if (d <= nearest_m) {
@@ -182,6 +184,10 @@ void LoopCloser::process(KeyframeInput in) {
       }
       event = e;
     }
+  }
+  if (!keyframes_[id].candidate) {  // a place already held: its cloud served this query only
+    keyframes_[id].cloud.resize(4, 0);
+    keyframes_[id].descriptor = ScanContext();
   }
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::lock_guard<std::mutex> lock(mutex_);

@@ -26,6 +26,7 @@ struct KeyframeInput {
   int frame = 0;  // scan index
   Pose odometry = Pose::Identity();  // T_world_lidar from SLOT_STATE
   PointCloud points;                 // static points, lidar frame
+  bool keep_cloud = true;            // false: used as a query now, not kept as a candidate (a place already held)
 };
 
 struct LoopEvent {
@@ -67,7 +68,8 @@ class LoopCloser {
     Pose odometry;
     double path_m = 0;
     ScanContext descriptor;
-    PointCloud cloud;  // downsampled to registration_voxel_m
+    PointCloud cloud;  // downsampled to registration_voxel_m; empty when not kept
+    bool candidate = true;  // its cloud and descriptor are kept
   };
   LoopConfig config_;
   ScanContextParams sc_params_;

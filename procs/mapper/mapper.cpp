@@ -85,11 +85,16 @@ void Mapper::commit(Pending& p) {
   gone.conservativeResize(4, ng);
   const int id = static_cast<int>(keyframes_.size());
   const Pose T_map = map_from_world_ * p.pose;
-  map_.insert(id, T_map, kept);
+  const size_t fresh = map_.insert(id, T_map, kept);
   removed_.insert(id, T_map, gone);
   keyframes_.push_back({p.frame, p.utime, p.pose, T_map, static_cast<int>(nk), static_cast<int>(ng)});
   keyframe_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  loops_->add({id, p.frame, p.pose, std::move(kept)});
+  // Only a keyframe that saw something new keeps its registration cloud for later loops: one
+  // that adds (almost) no voxel to the map is a place already held by earlier keyframes, so the
+  // loop closer's memory, like the map's, stops growing when the map does (driving in circles,
+  // standing in traffic).
+  const bool keep_cloud = static_cast<double>(fresh) >= config_.min_new_fraction * static_cast<double>(std::max<Eigen::Index>(nk, 1));
+  loops_->add({id, p.frame, p.pose, std::move(kept), keep_cloud});
   p.scan.resize(4, 0);
 }
 

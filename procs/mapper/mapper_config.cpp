@@ -25,6 +25,7 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
   c.remove_movable = remove == "movable";
   s.get("box_margin_m", c.box_margin_m);
   s.get("ground_clearance_m", c.ground_clearance_m);
+  s.get("min_new_fraction", c.min_new_fraction);
   s.get("decision_delay_frames", c.decision_delay_frames);
   s.get("follow_frames", c.follow_frames);
   s.get("join_timeout_s", c.join_timeout_s);
@@ -36,6 +37,8 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
     positive(s, k, v);
   if (!(c.min_range_m >= 0 && c.min_range_m < c.max_range_m))
     throw ConfigError(s.file() + ": " + s.path() + ".min_range_m: expected 0 <= min_range_m < max_range_m");
+  if (!(c.min_new_fraction >= 0 && c.min_new_fraction <= 1))
+    throw ConfigError(s.file() + ": " + s.path() + ".min_new_fraction: expected a value in [0, 1]");
   if (!(c.ground_clearance_m >= 0 && c.ground_clearance_m < 1.0))
     throw ConfigError(s.file() + ": " + s.path() + ".ground_clearance_m: expected a value in [0, 1) m");
   if (!(c.box_margin_m >= 0)) throw ConfigError(s.file() + ": " + s.path() + ".box_margin_m: expected a value >= 0");

@@ -32,6 +32,7 @@ struct MapperConfig {
   bool remove_movable = false;  // remove: movable (every track) instead of dynamic (moving tracks)
   double box_margin_m = 0.3;
   double ground_clearance_m = 0.1;
+  double min_new_fraction = 0.01;  // a keyframe keeps its loop-closure cloud when this share of its points made new voxels
   int decision_delay_frames = 15, follow_frames = 15;
   double join_timeout_s = 5.0;  // live: how long a scan waits for its SLOT_STATE (and back)
   LoopConfig loop;

@@ -33,15 +33,17 @@ void VoxelMap::add(const Eigen::Vector3d& p, const Eigen::Vector3f& local, int k
   voxels_.push_back(Voxel{local, keyframe, intensity});
 }
 
-void VoxelMap::insert(int keyframe, const Pose& T, const PointCloud& points) {
+size_t VoxelMap::insert(int keyframe, const Pose& T, const PointCloud& points) {
   if (keyframe < 0) throw std::invalid_argument("VoxelMap::insert: negative keyframe id");
   if (static_cast<size_t>(keyframe) >= poses_.size()) poses_.resize(keyframe + 1, Pose::Identity());
   poses_[keyframe] = T;
   last_cell_ = {kNoCell, kNoCell, kNoCell};
+  const size_t before = voxels_.size();
   for (Eigen::Index i = 0; i < points.cols(); ++i) {
     const Eigen::Vector3f local = points.col(i).head<3>();
     add(T * local.cast<double>(), local, keyframe, points(3, i));
   }
+  return voxels_.size() - before;
 }
 
 void VoxelMap::repose(const std::vector<Pose>& T_map_keyframe) {

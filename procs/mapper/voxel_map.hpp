@@ -27,7 +27,8 @@ class VoxelMap {
   explicit VoxelMap(double voxel_m) : voxel_(voxel_m), inverse_voxel_(1.0 / voxel_m) {}
 
   // points: the keyframe's points (x y z intensity columns) in its own frame; T_map_keyframe its pose.
-  void insert(int keyframe, const Pose& T_map_keyframe, const PointCloud& points);
+  // Returns the number of voxels the keyframe added (how much of what it saw is new).
+  size_t insert(int keyframe, const Pose& T_map_keyframe, const PointCloud& points);
   // Re-places every voxel with its keyframe's new pose (poses indexed by keyframe id); voxels
   // that now share a cell are merged.
   void repose(const std::vector<Pose>& T_map_keyframe);

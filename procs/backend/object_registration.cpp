@@ -149,12 +149,13 @@ std::vector<Eigen::Vector3d> thin(const ObjectPoints& points, const Eigen::Vecto
   }
   std::vector<char> taken(static_cast<size_t>(dims[0] * dims[1] * dims[2]), 0);
   out.reserve(points.size());
+  const double inv_cell = 1.0 / cell;
   for (const Eigen::Vector3f& p : points) {
     const Eigen::Vector3d q = p.cast<double>();
     long c[3];
     bool inside = true;
     for (int k = 0; k < 3; ++k) {
-      const double f = (q[k] - lo[k]) / cell;
+      const double f = (q[k] - lo[k]) * inv_cell;
       inside &= f >= 0 && f < dims[k];
       c[k] = inside ? static_cast<long>(f) : 0;
     }
@@ -219,17 +220,33 @@ RegistrationResult registerObject(const ObjectPoints& previous, const ObjectPoin
   double sigma2 = o.point_sigma * o.point_sigma;
   int inliers = 0;
   double wr2 = 0, wsum = 0;
+  // Each source point's correspondence and where the point was when it was searched: a point
+  // that has since moved less than a tenth of a voxel keeps it (the current points are a half
+  // voxel apart, so its nearest one rarely changes), which saves most of the searches once the
+  // iterations settle.
+  std::vector<int> match(source.size(), -1);
+  std::vector<Eigen::Vector3d> searched_at(source.size());
+  const double research2 = (0.1 * voxel) * (0.1 * voxel), max_r2 = o.max_residual * o.max_residual;
   for (int it = 0; it < o.max_iterations; ++it) {
     H.setZero();
     Vector6 g = Vector6::Zero();
     inliers = 0;
     wr2 = wsum = 0;
-    for (const Eigen::Vector3d& p : source) {
+    for (size_t i = 0; i < source.size(); ++i) {
+      const Eigen::Vector3d& p = source[i];
       const Eigen::Vector3d Rp = R * p;
       const Eigen::Vector3d q = Rp + t;
-      double d2;
-      const int j = grid.nearest(q, &d2);
-      if (j < 0 || d2 > o.max_residual * o.max_residual) continue;
+      int j = match[i];
+      if (it == 0 || (q - searched_at[i]).squaredNorm() > research2) {
+        double d2;
+        j = grid.nearest(q, &d2);
+        if (j >= 0 && d2 > max_r2) j = -1;
+        match[i] = j;
+        searched_at[i] = q;
+      } else if (j >= 0 && (q - target[j]).squaredNorm() > max_r2) {
+        j = -1;
+      }
+      if (j < 0) continue;
       const PlaneGrid::Plane& plane = grid.plane(j);
       if (!plane.valid) continue;
       const double r = plane.normal.dot(q - target[j]);

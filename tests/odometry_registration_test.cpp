@@ -157,8 +157,10 @@ TEST_P(OdometryPipeline, FollowsAConstructedDrive) {
     EXPECT_EQ(stages, (std::vector<std::string>{"features", "scan_to_scan", "scan_to_map", "total"}));
     T = T * step;
   }
-  // Every registered scan, or only the second (no velocity to predict from yet).
-  EXPECT_EQ(scan_to_scan_runs, GetParam() ? 19 : 1);
+  // Every registered scan, or the second (no velocity to predict from yet) and the velocity
+  // checks: the third scan (the first motion's) and every check_every_frames-th after it.
+  ASSERT_EQ(config().check_every_frames, 10);
+  EXPECT_EQ(scan_to_scan_runs, GetParam() ? 19 : 3);
 }
 
 // Braking at 1 g from 15 m/s to a stop: the constant-velocity prediction is 0.1 m ahead every

@@ -62,6 +62,7 @@ void LidarOdometry::reset() {
   registered_velocity_ = Pose::Identity();
   last_index_ = 0;
   frames_since_check_ = 0;
+  pending_disagreement_m_ = 0.0;
 }
 
 void LidarOdometry::fallBack(Status status, const std::string& why, const Pose& prediction, OdometryResult& out) {
@@ -231,37 +232,108 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
       // two disagree beyond both covariances (chi-square, 1 degree of freedom) and by more than
       // the map registration's own search can pull back, scan-to-scan's motion is taken and the
       // map, built with the wrong velocity, is started over.
+      //
+      // Scan-to-scan from the prediction alone is not independent of the velocity: its
+      // correspondences stick to surfaces that run along the motion (rails, road, walls), and from
+      // a prediction 2 m off it moves only 0.1-0.15 m and stops after its outer_iterations
+      // searches without converging. So when it did not converge, or disagrees, the velocity is
+      // suspect and scan-to-scan starts again from forward motion hypotheses that do not depend
+      // on it (registerMotionHypotheses: 0 .. max_forward_m, each within one registration's reach
+      // of the next); the one explaining most of the scan is the independent estimate.
       const TranslationConstraint map_c = translationConstraint(s2m.solution.normal_matrix);
       const bool weak = map_c.ratio() < cfg_.weak_direction_ratio;
-      const bool audit = cfg_.check_every_frames > 0 && frames_since_check_ + 1 >= cfg_.check_every_frames;
+      const double pending = pending_disagreement_m_;  // the last scan's check disagreed by this
+      pending_disagreement_m_ = 0.0;
+      const bool audit =
+          (cfg_.check_every_frames > 0 && frames_since_check_ + 1 >= cfg_.check_every_frames) || pending != 0.0;
       if (weak || audit) {
         frames_since_check_ = -1;  // counted up to 0 below
+        out.velocity_checked = true;
         if (weak) {
           out.weak_direction = map_c.weakest();
           out.degeneracy = Degeneracy::Unchecked;
         }
         s2m_ms += msSince(t);
-        const bool ok = scanToScan(false);
-        t = Clock::now();
-        if (ok) {
+        const Pose& map_pose = s2m.solution.T_ref_cur;
+        // The check against the map registration: true when scan-to-scan can tell (it is not as
+        // weak along the direction compared), filling out.check_*; `disagrees` when it does
+        // beyond both covariances and beyond what the map's own search pulls back.
+        bool disagrees = false;
+        auto compare = [&]() -> bool {
+          out.check_disagreement_m = out.check_chi2 = 0.0;
+          disagrees = false;
           const TranslationConstraint s2s_c = translationConstraint(s2s_last.solution.normal_matrix);
-          const Pose& map_pose = s2m.solution.T_ref_cur;
           const Eigen::Vector3d d = map_pose.linear().transpose() * (s2s_pose.translation() - map_pose.translation());
           // The weak direction, or on an audit the direction of the disagreement itself.
           const Eigen::Vector3d v = weak || d.norm() < 1e-9 ? map_c.weakest() : Eigen::Vector3d(d.normalized());
           // Scan-to-scan as weak along v (the same missing structure) cannot tell.
           const double s2s_info =
               v.dot(s2s_c.directions * s2s_c.information.asDiagonal() * s2s_c.directions.transpose() * v);
-          if (s2s_info >= cfg_.weak_direction_ratio * s2s_c.information(2)) {
-            out.check_disagreement_m = v.dot(d);
-            out.check_chi2 = chiSquareAlong(d, v, translationCovariance(map_c, cfg_), translationCovariance(s2s_c, cfg_));
-            if (weak) out.degeneracy = Degeneracy::Confirmed;
-            if (out.check_chi2 > cfg_.check_chi2 &&
-                std::abs(out.check_disagreement_m) > cfg_.check_min_disagreement_m) {
-              reanchored = true;
-              out.weak_direction = v;
-              out.degeneracy = Degeneracy::Reanchored;
+          if (s2s_info < cfg_.weak_direction_ratio * s2s_c.information(2)) return false;
+          out.check_disagreement_m = v.dot(d);
+          out.check_chi2 = chiSquareAlong(d, v, translationCovariance(map_c, cfg_), translationCovariance(s2s_c, cfg_));
+          out.check_direction = v;
+          disagrees = out.check_chi2 > cfg_.check_chi2 && std::abs(out.check_disagreement_m) > cfg_.check_min_disagreement_m;
+          return true;
+        };
+        bool ok = scanToScan(false) && compare();
+        // The correspondences it left unexplained may agree on another forward motion (traffic
+        // moving with the ego can hold scan-to-scan at the wrong velocity while the static
+        // structure says otherwise): scan-to-scan from there too, the one explaining more wins.
+        if (ok && !disagrees) {
+          const auto t_s2s = Clock::now();
+          const double cpu_match = threadCpuMs();
+          const Pose T = s2s_last.solution.T_ref_cur;
+          const Matches m = matchScanToScan(features, reference_, T, cfg_.scan_to_scan);
+          s2s_match += threadCpuMs() - cpu_match;
+          const double shift = outlierShift(m, T, T.linear().col(0), cfg_.scan_to_scan.solver.huber_delta_m,
+                                            cfg_.scan_to_scan.hypothesis_spacing_m, cfg_.scan_to_scan.max_forward_m,
+                                            cfg_.scan_to_scan.min_correspondences);
+          if (std::isfinite(shift)) {
+            Pose start = T;
+            start.translation() += shift * T.linear().col(0);
+            const Registration other = registerScanToScan(features, reference_, start, cfg_.scan_to_scan);
+            s2s_match += other.match_ms;
+            s2s_solve += other.solve_ms;
+            out.motion_hypotheses = 1;
+            if (other.solution.ok && other.solution.num_inliers > s2s_last.solution.num_inliers) {
+              s2s_last = other;
+              s2s_pose = T_world_reference_ * other.solution.T_ref_cur;
+              ok = compare();
             }
+          }
+          s2s_ms += msSince(t_s2s);
+        }
+        // Still moving by more than its convergence step: the start was beyond its reach.
+        if (!ok || disagrees || s2s_last.last_step_m >= cfg_.scan_to_scan.solver.converged_step_m) {
+          const auto t_s2s = Clock::now();
+          Registration searched = registerMotionHypotheses(features, reference_, T_world_reference_.inverse() * prediction,
+                                                           forwardHypotheses(cfg_.scan_to_scan), cfg_.scan_to_scan,
+                                                           &out.motion_hypotheses);
+          s2s_match += searched.match_ms;
+          s2s_solve += searched.solve_ms;
+          s2s_ms += msSince(t_s2s);
+          if (searched.solution.ok) {
+            s2s_last = searched;
+            s2s_pose = T_world_reference_ * searched.solution.T_ref_cur;
+            ok = compare();
+          }
+        }
+        t = Clock::now();
+        if (ok) {
+          if (weak) out.degeneracy = Degeneracy::Confirmed;
+          // One scan pair can be outvoted by chance (along a highway the inlier counts of motions
+          // metres apart differ by a few percent); a wrong velocity disagrees again on the next
+          // scan, the same way, a chance winner does not. So a first disagreement only makes the
+          // next scan checked too, and the second in a row re-anchors.
+          if (disagrees && pending * out.check_disagreement_m > 0.0) {
+            reanchored = true;
+            out.weak_direction = out.check_direction;
+            out.degeneracy = Degeneracy::Reanchored;
+          } else if (disagrees) {
+            pending_disagreement_m_ = out.check_disagreement_m;
+            out.weak_direction = out.check_direction;
+            out.degeneracy = Degeneracy::Suspected;
           }
         }
       }
@@ -278,6 +350,9 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
     pose = reanchored ? s2s_pose : s2m.solution.T_ref_cur;
     if (reanchored) map_.clear();
     ++frames_since_check_;
+    // The first motion came from starts 1 m apart (first_motion_guesses_m), which along a
+    // highway can all miss: the next map registration, the first from a velocity, is checked.
+    if (!moving_) frames_since_check_ = std::max(0, cfg_.check_every_frames - 1);
     out.status = Status::Ok;
     if (fallbacks_ > 0) {  // registered again: said once, for the logs
       const Pose correction = prediction.inverse() * pose;
@@ -290,16 +365,27 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
       out.translation_information = c.information;
       if (out.degeneracy == Degeneracy::None) out.weak_direction = c.weakest();
       if (out.degeneracy != Degeneracy::None) {
-        char buf[200];
+        char buf[300];
         const Eigen::Vector3d& v = out.weak_direction;
-        std::snprintf(buf, sizeof buf,
-                      "weakly constrained along (%.2f, %.2f, %.2f) (information ratio %.1e): %s", v.x(), v.y(), v.z(),
-                      c.ratio(),
-                      out.degeneracy == Degeneracy::Unchecked ? "scan-to-scan could not check it"
+        const TranslationConstraint map_c = translationConstraint(s2m.solution.normal_matrix);
+        // Why the velocity was checked: a weak direction of the map registration, or the
+        // periodic check (a map built with a wrong velocity agrees with it).
+        const bool was_weak = map_c.ratio() < cfg_.weak_direction_ratio;
+        const std::string why =
+            was_weak ? "weakly constrained along (" : "velocity check (every " + std::to_string(cfg_.check_every_frames) +
+                                                          " frames) along (";
+        std::snprintf(buf, sizeof buf, "%s%.2f, %.2f, %.2f) (information ratio %.1e%s): %s", why.c_str(), v.x(), v.y(),
+                      v.z(), map_c.ratio(),
+                      out.motion_hypotheses > 0
+                          ? (", " + std::to_string(out.motion_hypotheses) + " motion hypotheses searched").c_str()
+                          : "",
+                      out.degeneracy == Degeneracy::Unchecked   ? "scan-to-scan could not check it"
                       : out.degeneracy == Degeneracy::Confirmed ? "scan-to-scan agrees"
-                                                                : "scan-to-scan disagreed, velocity re-anchored, map restarted");
+                      : out.degeneracy == Degeneracy::Suspected
+                          ? "scan-to-scan disagreed, the next scan is checked too"
+                          : "scan-to-scan disagreed twice in a row, velocity re-anchored, map restarted");
         std::string text = buf;
-        if (out.degeneracy == Degeneracy::Reanchored)
+        if (out.degeneracy == Degeneracy::Reanchored || out.degeneracy == Degeneracy::Suspected)
           text += " (" + std::to_string(out.check_disagreement_m) + " m, chi-square " + std::to_string(out.check_chi2) + ")";
         out.status_text += (out.status_text.empty() ? "" : "; ") + text;
       }

@@ -25,6 +25,8 @@ enum class Degeneracy {
   Reanchored,    // scan-to-scan disagreed (along a weak direction, or on a periodic check): the
                  // motion is scan-to-scan's, the map starts over
   Unchecked,     // a weak direction, and scan-to-scan could not check it (failed or as weak)
+  Suspected,     // scan-to-scan disagreed once: the next scan is checked too, a second
+                 // disagreement the same way re-anchors
 };
 
 struct OdometryResult {
@@ -43,6 +45,9 @@ struct OdometryResult {
   Degeneracy degeneracy = Degeneracy::None;
   double check_disagreement_m = 0.0;  // scan-to-scan minus scan-to-map along weak_direction
   double check_chi2 = 0.0;            // ...its chi-square (1 dof) against both covariances
+  Eigen::Vector3d check_direction = Eigen::Vector3d::Zero();  // the direction compared (lidar frame)
+  bool velocity_checked = false;      // scan-to-scan checked the map registration on this scan
+  int motion_hypotheses = 0;          // ...and searched this many motion hypotheses (0: none)
   int num_points_in = 0;
   int num_points_removed = 0;
   int num_edge = 0, num_plane = 0;            // sharp and flat features
@@ -87,6 +92,7 @@ class LidarOdometry {
   Pose registered_velocity_ = Pose::Identity();  // velocity_ at the last registration (never decayed)
   int last_index_ = 0;                         // frame index of the last scan
   int frames_since_check_ = 0;                 // map registrations since scan-to-scan last checked one
+  double pending_disagreement_m_ = 0.0;        // the last check disagreed by this (0: it did not)
 };
 
 }  // namespace dlslot::odometry

@@ -85,7 +85,9 @@ int runNode(const NodeOptions& node_opts, const Channels& channels, const Odomet
       status.count("fallback_frames");
     } else if (r.degeneracy != Degeneracy::None) {  // a weak direction (degeneracy.hpp), checked or not
       status.warn("frame " + std::to_string(frame.index) + ": " + r.status_text);
-      status.count(r.degeneracy == Degeneracy::Reanchored ? "reanchored_frames" : "weak_direction_frames");
+      status.count(r.degeneracy == Degeneracy::Reanchored  ? "reanchored_frames"
+                   : r.degeneracy == Degeneracy::Suspected ? "velocity_suspect_frames"
+                                                           : "weak_direction_frames");
     } else if (!r.status_text.empty()) {  // registered again after fallbacks (fallback_motion.hpp)
       status.warn("frame " + std::to_string(frame.index) + ": " + r.status_text);
       status.count("recovered_frames");

@@ -59,10 +59,14 @@ void readScanToScan(ConfigSection s, ScanToScanConfig& c) {
   s.get("candidates", c.candidates);
   s.get("min_correspondences", c.min_correspondences);
   s.get("first_motion_guesses_m", c.first_motion_guesses_m);
+  s.get("max_forward_m", c.max_forward_m);
+  s.get("hypothesis_spacing_m", c.hypothesis_spacing_m);
   s.finish();
-  if (c.first_motion_guesses_m.empty() || c.candidates < 3)
+  if (c.candidates < 3 || c.first_motion_guesses_m.empty() || !(c.max_forward_m >= 0.0) || !(c.hypothesis_spacing_m > 0.0) ||
+      c.max_forward_m / c.hypothesis_spacing_m > 1000.0)
     throw ConfigError(s.file() + ": " + s.path() +
-                      ": expected candidates >= 3 and at least one distance in first_motion_guesses_m");
+                      ": expected candidates >= 3, at least one distance in first_motion_guesses_m, max_forward_m >= 0 and 0 < hypothesis_spacing_m with at most "
+                      "1000 hypotheses up to max_forward_m");
 }
 
 void readScanToMap(ConfigSection s, ScanToMapConfig& c) {

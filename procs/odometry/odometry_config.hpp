@@ -58,7 +58,18 @@ struct ScanToScanConfig {
   int candidates = 10;                // ...among this many nearest previous points
   int min_correspondences = 30;
   // Forward distances (m) the second scan of a sequence is registered from (no velocity yet).
+  // Along a highway these starts 1 m apart can all miss (below): the third scan's velocity check
+  // (OdometryConfig::check_every_frames) catches that.
   std::vector<double> first_motion_guesses_m = {0.0, 1.0, 2.0, 3.0};
+  // Forward motion hypotheses (m per scan) for a velocity check that found the prediction
+  // suspect (lidar_odometry.cpp): registration starts from 0, spacing, 2 spacing, ...
+  // max_forward_m ahead and keeps the solution with the most inliers. The spacing is what one
+  // registration reaches: along a highway its nearest-neighbour correspondences stick to the
+  // rails and the road, so it moves only 0.1-0.15 m towards a motion 2 m away, but from 0.3 m
+  // off it lands within 0.1 m (docs/ego.md). The largest is 45 m/s at KITTI's 10 Hz, above any
+  // drive here.
+  double max_forward_m = 4.5;
+  double hypothesis_spacing_m = 0.25;
 };
 
 // Scan-to-map refinement against a local map (A-LOAM laserMapping).
@@ -110,7 +121,7 @@ struct OdometryConfig {
   // velocity that the map itself has come to agree with would last at most this many frames.
   // Off by default: on the constructed corridor scan-to-scan from the wrong prediction agreed
   // with the wrong map registration (docs/ego.md), so it is not yet shown to help.
-  int check_every_frames = 0;
+  int check_every_frames = 10;
   // ...and a disagreement is acted on only beyond this (m): closer, the map registration's own
   // correspondences (searched within scan_to_map.max_neighbor_distance_m, 1 m) reach the right
   // surfaces and pull it back by itself. Half that radius.

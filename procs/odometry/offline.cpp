@@ -40,6 +40,9 @@ int runOffline(const OfflineOptions& opts, const OdometryConfig& cfg) {
   std::map<Status, int> statuses;
   long removed = 0, points = 0;
   int scan_to_scan_runs = 0;  // scans that needed scan-to-scan (every_scan false: few)
+  // The velocity checks (lidar_odometry.cpp): scans checked, of those the ones that searched
+  // motion hypotheses, weakly constrained, and re-anchored.
+  int checked = 0, searched = 0, weak = 0, suspected = 0, reanchored = 0;
   // Per-scan statistics of registered scans, to compare simulated scans with real ones.
   TimingStats edges, planes, residuals, correspondences;
   ProgressLine progress("odometry " + opts.sequence + " (" + modeName(cfg.remove_detected_objects) + ")",
@@ -58,6 +61,11 @@ int runOffline(const OfflineOptions& opts, const OdometryConfig& cfg) {
       correspondences.add(r.num_correspondences);
     }
     points += r.num_points_in;
+    checked += r.velocity_checked ? 1 : 0;
+    searched += r.motion_hypotheses > 0 ? 1 : 0;
+    weak += r.degeneracy == Degeneracy::Confirmed || r.degeneracy == Degeneracy::Unchecked ? 1 : 0;
+    suspected += r.degeneracy == Degeneracy::Suspected ? 1 : 0;
+    reanchored += r.degeneracy == Degeneracy::Reanchored ? 1 : 0;
     for (const auto& [name, ms] : r.detail)
       if (name == "s2s_match" && ms > 0) ++scan_to_scan_runs;
     for (const auto& [name, ms] : r.timings) {
@@ -74,6 +82,9 @@ int runOffline(const OfflineOptions& opts, const OdometryConfig& cfg) {
               points > 0 ? 100.0 * removed / points : 0.0);
   for (const auto& [status, n] : statuses) std::printf("  %-26s %d frames\n", statusName(status), n);
   std::printf("scan-to-scan registration on %d of %d frames\n", scan_to_scan_runs, reader.size());
+  std::printf("velocity checked on %d frames (motion hypotheses searched on %d), weakly constrained %d, "
+              "disagreed once %d, re-anchored %d\n",
+              checked, searched, weak, suspected, reanchored);
   std::printf("%-14s %9s %9s %9s   (ms per frame)\n", "stage", "mean", "p95", "max");
   for (const std::string& name : stage_order)
     std::printf("%-14s %9.2f %9.2f %9.2f\n", name.c_str(), stages[name].mean(), stages[name].percentile(95),

@@ -94,9 +94,12 @@ Registration registerIteratively(const std::function<Matches(const Pose&)>& matc
     if (!r.solution.ok) break;
     // Correspondences searched at a pose this close to the solution would be the same ones.
     const Pose step = before.inverse() * r.solution.T_ref_cur;
+    r.last_step_m = step.translation().norm();
     if (step.translation().norm() < cfg.converged_step_m &&
-        Eigen::AngleAxisd(step.linear()).angle() < cfg.converged_step_deg * M_PI / 180.0)
+        Eigen::AngleAxisd(step.linear()).angle() < cfg.converged_step_deg * M_PI / 180.0) {
+      r.converged = true;
       break;
+    }
   }
   return r;
 }

@@ -55,6 +55,11 @@ void measureConstraint(const Matches& matches, double huber_delta, PoseSolution&
 struct Registration {
   PoseSolution solution;
   int num_correspondences = 0;  // of the last correspondence search
+  // The last solve moved the pose less than converged_step_*: a further search would change
+  // nothing. False after outer_iterations searches that each still moved it: the start was far
+  // from the solution and the registration only went part of the way.
+  bool converged = false;
+  double last_step_m = 0.0;  // the translation of the last solve's step
   double match_ms = 0.0;        // CPU time of this thread in correspondence searches
   double solve_ms = 0.0;        // ...and in solves
 };

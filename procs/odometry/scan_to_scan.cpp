@@ -1,6 +1,7 @@
 #include "scan_to_scan.hpp"
 
 #include <cmath>
+#include <limits>
 #include <utility>
 
 namespace dlslot::odometry {
@@ -97,14 +98,75 @@ Registration registerScanToScan(const ScanFeatures& current, ScanReference& prev
                              cfg.min_correspondences);
 }
 
-Registration registerFirstMotion(const ScanFeatures& current, ScanReference& previous, const ScanToScanConfig& cfg) {
-  Registration best;
-  for (double forward : cfg.first_motion_guesses_m) {
-    Pose guess = Pose::Identity();
-    guess.translation().x() = forward;
-    const Registration r = registerScanToScan(current, previous, guess, cfg);
-    if (r.solution.ok && (!best.solution.ok || r.solution.num_inliers > best.solution.num_inliers)) best = r;
+double outlierShift(const Matches& matches, const Pose& T_ref_cur, const Eigen::Vector3d& v, double huber_delta,
+                    double spacing, double max_abs_shift, int min_votes) {
+  const int bins = 2 * static_cast<int>(std::ceil(max_abs_shift / spacing)) + 1;
+  std::vector<int> count(bins, 0);
+  std::vector<double> sum(bins, 0.0);
+  auto vote = [&](double s) {
+    if (!(std::abs(s) <= max_abs_shift)) return;
+    const int b = static_cast<int>(std::lround(s / spacing)) + bins / 2;
+    if (b < 0 || b >= bins) return;
+    ++count[b];
+    sum[b] += s;
+  };
+  // A correspondence is informative along v when v moves it at least half as much as along its
+  // own residual direction (cos 60 deg).
+  for (const EdgeMatch& m : matches.edges) {
+    const Eigen::Vector3d q = T_ref_cur * m.p - m.a;
+    const Eigen::Vector3d e = q - m.u * m.u.dot(q);  // perpendicular residual
+    const Eigen::Vector3d w = v - m.u * m.u.dot(v);   // what a unit shift along v does to it
+    if (w.norm() < 0.5) continue;
+    if (e.norm() <= huber_delta) continue;
+    const double s = -e.dot(w) / w.squaredNorm();
+    if ((e + s * w).norm() <= huber_delta) vote(s);   // the shift explains the residual
   }
+  for (const PlaneMatch& m : matches.planes) {
+    const double r = m.n.dot(T_ref_cur * m.p) + m.d;
+    if (std::abs(m.n.dot(v)) < 0.5) continue;
+    if (std::abs(r) <= huber_delta) continue;
+    vote(-r / m.n.dot(v));
+  }
+  int best = -1;
+  for (int b = 0; b < bins; ++b)
+    // The bins next to no shift hold the residuals' own tails, and a motion that close is
+    // within the registration's reach anyway (it converges from there).
+    if (std::abs(b - bins / 2) > 1 && (best < 0 || count[b] > count[best])) best = b;
+  if (best < 0 || count[best] < min_votes) return std::numeric_limits<double>::quiet_NaN();
+  return sum[best] / count[best];
+}
+
+std::vector<double> forwardHypotheses(const ScanToScanConfig& cfg) {
+  std::vector<double> out;
+  const int steps = static_cast<int>(std::floor(cfg.max_forward_m / cfg.hypothesis_spacing_m + 1e-9));
+  for (int k = 0; k <= steps; ++k) out.push_back(k * cfg.hypothesis_spacing_m);
+  return out;
+}
+
+Registration registerMotionHypotheses(const ScanFeatures& current, ScanReference& previous, const Pose& guess,
+                                      const std::vector<double>& forward, const ScanToScanConfig& cfg,
+                                      int* hypotheses) {
+  Registration best;
+  double match_ms = 0.0, solve_ms = 0.0;
+  auto tryFrom = [&](const Pose& start) {
+    const Registration r = registerScanToScan(current, previous, start, cfg);
+    match_ms += r.match_ms;
+    solve_ms += r.solve_ms;
+    if (r.solution.ok && (!best.solution.ok || r.solution.num_inliers > best.solution.num_inliers)) best = r;
+  };
+  tryFrom(guess);
+  int n = 1;
+  for (double d : forward) {
+    Pose start = guess;
+    start.translation() = Eigen::Vector3d(d, 0.0, 0.0);
+    // The guess itself is tried already; a start within half a spacing of it adds nothing.
+    if ((start.translation() - guess.translation()).norm() < 0.5 * cfg.hypothesis_spacing_m) continue;
+    tryFrom(start);
+    ++n;
+  }
+  if (hypotheses) *hypotheses = n;
+  best.match_ms = match_ms;
+  best.solve_ms = solve_ms;
   return best;
 }
 

@@ -38,9 +38,32 @@ Matches matchScanToScan(const ScanFeatures& current, const ScanReference& previo
 Registration registerScanToScan(const ScanFeatures& current, ScanReference& previous, const Pose& guess,
                                 const ScanToScanConfig& cfg);
 
+// A motion no velocity can be trusted for: registration starts from `guess` and from each of the
+// `forward` distances along the lidar's x axis (with `guess`'s rotation), and the solution with
+// the most inlier correspondences wins. `hypotheses`, when given, is set to the number of starts
+// registered.
+Registration registerMotionHypotheses(const ScanFeatures& current, ScanReference& previous, const Pose& guess,
+                                      const std::vector<double>& forward, const ScanToScanConfig& cfg,
+                                      int* hypotheses = nullptr);
+// A second motion hypothesis from the correspondences a registration rejected. At T_ref_cur each
+// outlier (|residual| above huber_delta) whose residual a shift along the unit direction v (the
+// reference frame) can explain votes for that shift; votes are binned `spacing` wide. When the
+// most voted bin holds at least min_votes (scan-to-scan's min_correspondences: enough for a
+// registration of its own), structure that the solution left unexplained moves together by that
+// shift (posts of a corridor the wrong velocity put 2 m off, while traffic moving with the ego
+// held the solution): returns the mean shift of the bin's votes, else NaN. Shifts within one bin of
+// none are not counted: the residuals' own tails, and within the registration's reach anyway.
+double outlierShift(const Matches& matches, const Pose& T_ref_cur, const Eigen::Vector3d& v, double huber_delta,
+                    double spacing, double max_abs_shift, int min_votes);
+// The forward distances 0, spacing, 2 spacing, ... max_forward_m (a velocity check's search).
+std::vector<double> forwardHypotheses(const ScanToScanConfig& cfg);
 // The second scan of a sequence has no motion to extrapolate, yet the vehicle may already move
-// fast (a sequence starting on a highway): registration starts from each forward distance of
-// cfg.first_motion_guesses_m and keeps the solution with the most inlier correspondences.
-Registration registerFirstMotion(const ScanFeatures& current, ScanReference& previous, const ScanToScanConfig& cfg);
+// fast (a sequence starting on a highway): the starts of cfg.first_motion_guesses_m.
+inline Registration registerFirstMotion(const ScanFeatures& current, ScanReference& previous,
+                                        const ScanToScanConfig& cfg) {
+  Pose first = Pose::Identity();
+  first.translation().x() = cfg.first_motion_guesses_m.front();
+  return registerMotionHypotheses(current, previous, first, cfg.first_motion_guesses_m, cfg);
+}
 
 }  // namespace dlslot::odometry

@@ -139,6 +139,34 @@ TEST(EvalTracking, IdSwapCountsTwoSwitchesAndThirdsTheAssociation) {
   EXPECT_NEAR(h->hota, std::sqrt(1.0 / 3.0), 1e-12);
 }
 
+TEST(EvalTracking, HeadingErrorOfMovingCars) {
+  // Frame 0: a car moving at 10 m/s, tracked 2 deg off; frame 1: the same car at yaw 179 deg,
+  // tracked at -179 deg (2 deg across the wrap, not 358). Not counted: a dynamic car crawling at
+  // 0.5 m/s tracked 30 deg off, a static car 50 deg off, a moving pedestrian 40 deg off.
+  // Heading RMSE = sqrt((2^2 + 2^2) / 2) = 2 deg over 2 pairs.
+  const double deg = M_PI / 180;
+  const auto label = [](Box b, double speed, bool dynamic) { return Object{b, Eigen::Vector2d(speed, 0), dynamic}; };
+  std::vector<TrackingFrame> frames(2);
+  for (int t = 0; t < 2; ++t) {
+    const double yaw = t == 0 ? 10 * deg : 179 * deg, tracked = t == 0 ? 12 * deg : -179 * deg;
+    frames[t].frame = t;
+    frames[t].truth = {label(box(0, t, 1, "Car", yaw), 10, true), label(box(20, 0, 2, "Car", 0), 0.5, true),
+                       label(box(40, 0, 3, "Car", 0), 0, false), label(box(60, 0, 4, "Pedestrian", 0), 1.5, true)};
+    frames[t].tracks = {label(box(0, t, 10, "Car", tracked), 10, false), label(box(20, 0, 20, "Car", 30 * deg), 0.5, false),
+                        label(box(40, 0, 30, "Car", 50 * deg), 0, false),
+                        label(box(60, 0, 40, "Pedestrian", 40 * deg), 1.5, false)};
+  }
+  const ClearMot m = evaluateClearMot(frames, kDistance);
+  EXPECT_EQ(m.tp, 8);
+  EXPECT_EQ(m.heading_pairs, 2);
+  ASSERT_TRUE(m.heading_rmse_deg);
+  EXPECT_NEAR(*m.heading_rmse_deg, 2.0, 1e-9);
+  // A car tracked the wrong way round: 180 deg.
+  frames[0].tracks[0].box.yaw = 10 * deg + M_PI;
+  frames.resize(1);
+  EXPECT_NEAR(*evaluateClearMot(frames, kDistance).heading_rmse_deg, 180.0, 1e-9);
+}
+
 TEST(EvalTracking, MissesAndFalsePositives) {
   // One label over 5 frames, tracked (id 10) in frames 0, 1, 4 only: FN = 2; a spurious track
   // (id 99) far away in frame 3: FP = 1. MOTA = 1 - 3/5 = 0.4.

@@ -20,6 +20,13 @@ struct ClearMot {
   // Velocity error of matched labels that are dynamic and have a velocity on both sides.
   int velocity_pairs = 0;
   std::optional<double> velocity_rmse_mps;
+  // Heading error of matched moving cars: labels of type Car that are dynamic and whose own speed
+  // is at least kMovingSpeedMps (a car's heading is its direction of travel; a parked or crawling
+  // car's box orientation is not what a planner reads). The yaw difference is wrapped to
+  // [-180, 180) deg, so a box turned round counts as 180 deg, not 0.
+  static constexpr double kMovingSpeedMps = 1.0;
+  int heading_pairs = 0;
+  std::optional<double> heading_rmse_deg;
   // Every matched pair with a velocity on both sides, static labels included (for the breakdown).
   std::vector<VelocityPair> velocities;
 };

@@ -61,7 +61,9 @@ std::vector<std::pair<std::string, Opt>> trackingValues(const std::optional<Trac
           {"fp", count(&ClearMot::fp)},
           {"fn", count(&ClearMot::fn)},
           {"hota", t && t->hota ? Opt(t->hota->hota) : std::nullopt},
-          {"velocity_rmse_mps", t ? t->clear.velocity_rmse_mps : std::nullopt}};
+          {"velocity_rmse_mps", t ? t->clear.velocity_rmse_mps : std::nullopt},
+          {"heading_rmse_deg", t ? t->clear.heading_rmse_deg : std::nullopt},
+          {"heading_pairs", count(&ClearMot::heading_pairs)}};
 }
 
 
@@ -117,7 +119,7 @@ Table egoTable(const Metrics& m) {
 
 Table trackingTable(const Metrics& m) {
   Table t({"matching", "MOTA", "MOTP m", "IDSW", "FP", "FN", "TP", "labels", "HOTA", "DetA", "AssA", "LocA",
-           "velocity RMSE m/s", "velocity pairs"});
+           "velocity RMSE m/s", "velocity pairs", "heading RMSE deg (moving cars)"});
   for (const auto* tm : {&m.tracking, &m.tracking_iou}) {
     if (!*tm) continue;
     const ClearMot& c = (*tm)->clear;
@@ -126,7 +128,7 @@ Table trackingTable(const Metrics& m) {
            std::to_string(c.fp), std::to_string(c.fn), std::to_string(c.tp), std::to_string(c.num_truth),
            cell(h ? Opt(h->hota) : std::nullopt, "%.4f"), cell(h ? Opt(h->deta) : std::nullopt, "%.4f"),
            cell(h ? Opt(h->assa) : std::nullopt, "%.4f"), cell(h ? Opt(h->loca) : std::nullopt, "%.4f"),
-           cell(c.velocity_rmse_mps, "%.3f"), std::to_string(c.velocity_pairs)});
+           cell(c.velocity_rmse_mps, "%.3f"), std::to_string(c.velocity_pairs), cell(c.heading_rmse_deg, "%.2f")});
   }
   return t;
 }

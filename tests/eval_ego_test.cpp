@@ -250,3 +250,26 @@ TEST(EvalEgo, ARunStartingLaterInTheSequenceIsComparedInItsOwnWorld) {
   EXPECT_EQ(m.primary_source, "slot");
   EXPECT_FALSE(m.tracking);  // no labels
 }
+
+// Speed jumps: braking at 1 g is a car's, not a jump; a velocity re-anchored from 0.2 to 2.4 m per
+// scan (the odometry's recovery from a wrong speed) is one; without stamps nothing is said.
+TEST(EgoImplausible, CountsSpeedJumpsAboveTwoG) {
+  auto drive = [](const std::vector<double>& steps, bool stamped) {
+    Trajectory t;
+    Pose T = Pose::Identity();
+    t.add(0, stamped ? 0.0 : -1.0, T);
+    for (size_t i = 0; i < steps.size(); ++i) {
+      T.translation().x() += steps[i];
+      t.add(static_cast<int>(i + 1), stamped ? 0.1 * static_cast<double>(i + 1) : -1.0, T);
+    }
+    if (!stamped) t.stamps.clear();
+    return t;
+  };
+  std::vector<double> braking;  // 25 m/s, 1 g: 0.098 m/s less per 0.1 s scan
+  for (double v = 25.0; v > 0; v -= 0.981) braking.push_back(0.1 * v);
+  EXPECT_EQ(implausibleSpeedJumps(drive(braking, true)), 0.0);
+  std::vector<double> reanchored(10, 0.2);
+  for (int i = 0; i < 10; ++i) reanchored.push_back(2.4);
+  EXPECT_EQ(implausibleSpeedJumps(drive(reanchored, true)), 1.0);
+  EXPECT_FALSE(implausibleSpeedJumps(drive(reanchored, false)).has_value());
+}

@@ -149,12 +149,31 @@ std::optional<SegmentErrors> segmentErrors(const Trajectory& est, const Trajecto
   return s;
 }
 
+std::optional<double> implausibleSpeedJumps(const Trajectory& est) {
+  if (est.stamps.size() != est.size() || est.size() < 3) return std::nullopt;
+  constexpr double kMaxAcceleration = 2.0 * 9.81;  // m/s^2
+  int jumps = 0;
+  double last_speed = -1.0;
+  for (size_t i = 1; i < est.size(); ++i) {
+    const double dt = est.stamps[i] - est.stamps[i - 1];
+    if (!(dt > 0)) {
+      last_speed = -1.0;
+      continue;
+    }
+    const double speed = (est.poses[i].translation() - est.poses[i - 1].translation()).norm() / dt;
+    if (last_speed >= 0 && std::abs(speed - last_speed) > kMaxAcceleration * dt) ++jumps;
+    last_speed = speed;
+  }
+  return jumps;
+}
+
 EgoMetrics evaluateEgo(const Trajectory& est, const Trajectory& gt) {
   requireSameFrames(est, gt);
   EgoMetrics m;
   m.frames = static_cast<int>(est.size());
   if (est.empty()) return m;
   m.path_length_m = pathDistances(gt).back();
+  m.implausible_frames = implausibleSpeedJumps(est);
   m.ate_rmse_m = ateRmse(est, gt, true);
   m.ate_unaligned_rmse_m = ateRmse(est, gt, false);
   if (const auto r = relativePoseError(est, gt, 1)) {

@@ -59,7 +59,15 @@ struct EgoMetrics {
   std::optional<double> velocity_rmse_mps;  // over 5 scans, as the backend's object velocities
   std::optional<double> t_rel_pct, r_rel_deg_per_100m, t_rel_short_pct, r_rel_short_deg_per_100m;
   std::optional<SegmentErrors> devkit, short_segments;
+  // Scans where the estimate's own speed changed faster than any car can (implausibleSpeedJumps):
+  // a run whose ego is lost says so, with or without ground truth.
+  std::optional<double> implausible_frames;
 };
+// Scans whose estimated speed (each scan's motion over its time step) differs from the previous
+// scan's by more than 2 g times the step: twice the braking of a car on dry road, so neither a
+// real manoeuvre nor the per-scan noise of a registration (a few cm) reaches it, while a
+// velocity that was wrong and is re-anchored (metres per scan) does. nullopt without stamps.
+std::optional<double> implausibleSpeedJumps(const Trajectory& est);
 EgoMetrics evaluateEgo(const Trajectory& est, const Trajectory& gt);
 
 }  // namespace dlslot::eval

@@ -46,6 +46,7 @@ const std::vector<std::pair<std::string, std::function<Opt(const EgoMetrics&)>>>
       {"t_rel_short_pct", [](const EgoMetrics& e) { return e.t_rel_short_pct; }},
       {"r_rel_short_deg_per_100m", [](const EgoMetrics& e) { return e.r_rel_short_deg_per_100m; }},
       {"velocity_rmse_mps", [](const EgoMetrics& e) { return e.velocity_rmse_mps; }},
+      {"implausible_frames", [](const EgoMetrics& e) { return e.implausible_frames; }},
   };
   return keys;
 }
@@ -431,6 +432,9 @@ std::string summaryLine(const Metrics& m) {
     out << " " << m.primary_source << " ATE " << cell(primary->second->ate_rmse_m, "%.3f") << " m, t_rel "
         << cell(primary->second->t_rel_pct ? primary->second->t_rel_pct : primary->second->t_rel_short_pct, "%.2f")
         << (primary->second->t_rel_pct ? " %" : " % (10-80 m)");
+  if (primary != m.ego.end() && primary->second && primary->second->implausible_frames.value_or(0) > 0)
+    out << "; ego speed jumps above 2 g on " << static_cast<int>(*primary->second->implausible_frames)
+        << " scans (a lost or re-anchored ego: check the odometry's warnings)";
   if (m.tracking)
     out << "; MOTA " << cell(m.tracking->clear.mota, "%.3f") << ", HOTA "
         << cell(m.tracking->hota ? Opt(m.tracking->hota->hota) : std::nullopt, "%.3f") << ", IDSW "

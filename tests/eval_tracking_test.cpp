@@ -161,10 +161,15 @@ TEST(EvalTracking, HeadingErrorOfMovingCars) {
   EXPECT_EQ(m.heading_pairs, 2);
   ASSERT_TRUE(m.heading_rmse_deg);
   EXPECT_NEAR(*m.heading_rmse_deg, 2.0, 1e-9);
-  // A car tracked the wrong way round: 180 deg.
+  EXPECT_EQ(m.heading_reversed, 0);
+  EXPECT_NEAR(*m.heading_rmse_unreversed_deg, 2.0, 1e-9);
+  // The car tracked the wrong way round in frame 0: 180 deg; sqrt((180^2 + 2^2) / 2) over both,
+  // one reversed, 2 deg for the other.
   frames[0].tracks[0].box.yaw = 10 * deg + M_PI;
-  frames.resize(1);
-  EXPECT_NEAR(*evaluateClearMot(frames, kDistance).heading_rmse_deg, 180.0, 1e-9);
+  const ClearMot r = evaluateClearMot(frames, kDistance);
+  EXPECT_NEAR(*r.heading_rmse_deg, std::sqrt((180.0 * 180.0 + 4.0) / 2), 1e-9);
+  EXPECT_EQ(r.heading_reversed, 1);
+  EXPECT_NEAR(*r.heading_rmse_unreversed_deg, 2.0, 1e-9);
 }
 
 TEST(EvalTracking, MissesAndFalsePositives) {

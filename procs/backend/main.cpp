@@ -118,9 +118,11 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
     else accepted[index] = msg->frame;
     return !why;
   };
-  // The newest scan (per-object registration): a frame's scan comes before its associations.
+  // The newest scans (per-object registration), by frame: a frame's scan comes before its
+  // associations, but the player's next scans may too (the tracker answers later), so the newest
+  // few are kept, as live.
   const bool use_scans = !config.registration_types.empty() && config.mode != Mode::kOdometryOnly;
-  std::optional<std::pair<int, PointCloud>> scan;
+  std::map<int, PointCloud> scans;
   std::map<std::string, FrameOrder> scan_order;
   LogEnvelopes envelopes(in_path);  // every event verified as it would be live (lcm_log.hpp)
   for (; const lcm::LogEvent* raw = nextLogEvent(in, in_path); ++index) {
@@ -131,7 +133,10 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
       Refusal why = decodeChecked(ev->data, static_cast<size_t>(std::max(ev->datalen, 0)), &m);
       if (!why) why = scan_order[ev->channel].accept(m.frame);
       if (why) guard.refused(ev->channel, why, in_path + ": event " + std::to_string(index) + ": ");
-      else scan.emplace(m.frame, dlslot::fromMsg(m));
+      else {
+        scans[m.frame] = dlslot::fromMsg(m);
+        while (scans.size() > 3) scans.erase(scans.begin());
+      }
     } else if (ev->channel == channels.odometry) {
       odometry_t m;
       if (decode(*ev, &m)) joiner.addA(m.frame, OdometryPart{m.utime, fromMsg(m)}, 0.0);
@@ -139,7 +144,8 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
       associations_t m;
       if (decode(*ev, &m)) {
         AssociationsPart part{m.utime, observationsFromMsg(m, &rejected)};
-        if (scan && scan->first == m.frame) attachObjectPoints(scan->second, config, part.observations);
+        if (const auto it = scans.find(m.frame); it != scans.end())
+          attachObjectPoints(it->second, config, part.observations);
         joiner.addB(m.frame, std::move(part), 0.0);
       }
     }

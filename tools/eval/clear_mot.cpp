@@ -13,7 +13,7 @@ ClearMot evaluateClearMot(const std::vector<TrackingFrame>& frames, const MatchC
   std::map<int, int> previous;    // label id -> track id, matched in the previous frame
   std::map<int, int> last_match;  // label id -> track id it was last matched to, any frame
   std::map<int, int> first_output;  // track id -> index of the first frame it was output in
-  double distance_sum = 0, velocity_sq_sum = 0, heading_sq_sum = 0;
+  double distance_sum = 0, velocity_sq_sum = 0, heading_sq_sum = 0, unreversed_sq_sum = 0;
   for (size_t index = 0; index < frames.size(); ++index) {
     const TrackingFrame& f = frames[index];
     for (const Object& h : f.tracks) first_output.emplace(h.box.id, static_cast<int>(index));
@@ -69,6 +69,10 @@ ClearMot evaluateClearMot(const std::vector<TrackingFrame>& frames, const MatchC
         const double d = std::remainder(h.box.yaw - g.box.yaw, 2.0 * M_PI) * 180.0 / M_PI;
         heading_sq_sum += d * d;
         ++m.heading_pairs;
+        if (std::abs(d) > 90.0)
+          ++m.heading_reversed;
+        else
+          unreversed_sq_sum += d * d;
       }
     }
     previous = std::move(current);
@@ -81,6 +85,8 @@ ClearMot evaluateClearMot(const std::vector<TrackingFrame>& frames, const MatchC
   if (m.tp > 0) m.motp_m = distance_sum / m.tp;
   if (m.velocity_pairs > 0) m.velocity_rmse_mps = std::sqrt(velocity_sq_sum / m.velocity_pairs);
   if (m.heading_pairs > 0) m.heading_rmse_deg = std::sqrt(heading_sq_sum / m.heading_pairs);
+  if (m.heading_pairs > m.heading_reversed)
+    m.heading_rmse_unreversed_deg = std::sqrt(unreversed_sq_sum / (m.heading_pairs - m.heading_reversed));
   return m;
 }
 

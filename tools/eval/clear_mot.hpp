@@ -27,6 +27,9 @@ struct ClearMot {
   static constexpr double kMovingSpeedMps = 1.0;
   int heading_pairs = 0;
   std::optional<double> heading_rmse_deg;
+  // Of those, the boxes more than 90 deg off (turned round), and the RMSE of the rest.
+  int heading_reversed = 0;
+  std::optional<double> heading_rmse_unreversed_deg;
   // Every matched pair with a velocity on both sides, static labels included (for the breakdown).
   std::vector<VelocityPair> velocities;
 };

@@ -63,7 +63,9 @@ std::vector<std::pair<std::string, Opt>> trackingValues(const std::optional<Trac
           {"hota", t && t->hota ? Opt(t->hota->hota) : std::nullopt},
           {"velocity_rmse_mps", t ? t->clear.velocity_rmse_mps : std::nullopt},
           {"heading_rmse_deg", t ? t->clear.heading_rmse_deg : std::nullopt},
-          {"heading_pairs", count(&ClearMot::heading_pairs)}};
+          {"heading_pairs", count(&ClearMot::heading_pairs)},
+          {"heading_reversed", count(&ClearMot::heading_reversed)},
+          {"heading_rmse_unreversed_deg", t ? t->clear.heading_rmse_unreversed_deg : std::nullopt}};
 }
 
 

@@ -7,6 +7,8 @@
 #include <cstring>
 #include <set>
 
+#include "ros1_point_cloud.hpp"
+
 namespace dlslot::foxglove {
 namespace {
 
@@ -75,7 +77,8 @@ void idColour(int id, float rgba[4]) {
 
 Converter::Converter(const Channels& channels, ConverterOptions options) : channels_(channels), opt_(options) {
   topics_ = {
-      {"/lidar/points", &pointCloudSchema(), channels_.scan},
+      {"/lidar/points", opt_.scan_encoding == ScanEncoding::kRos1 ? &pointCloud2Schema() : &pointCloudSchema(),
+       channels_.scan},
       {"/detections", &sceneUpdateSchema(), channels_.detections},
       {"/ground_truth/boxes", &sceneUpdateSchema(), channels_.ground_truth},
       {"/ground_truth/path", &posesInFrameSchema(), channels_.ground_truth},
@@ -107,6 +110,11 @@ Refusal Converter::convert(const std::string& channel, const void* data, size_t 
 
 void Converter::add(const point_cloud_t& m, std::vector<Output>& out) {
   if (!wanted(kScan)) return;
+  if (opt_.scan_encoding == ScanEncoding::kRos1) {
+    out.push_back({kScan, {}, m.utime});
+    ros1::writePointCloud2(m, kLidarFrame, out.back().bytes);
+    return;
+  }
   // Interleaved little-endian float32 x y z intensity, 16 bytes a point (x86 is little-endian,
   // as Foxglove's packed fields are).
   static_assert(sizeof(float) == 4, "float32");

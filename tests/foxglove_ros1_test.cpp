@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <limits>
 #include <random>
 
 #include "foxglove_convert.hpp"
@@ -143,6 +144,71 @@ TEST(Ros1PointCloud, DefinitionListsTheFieldsInWireOrderAndTheTypesItUses) {
   EXPECT_NE(d.find("\n" + std::string(80, '=') + "\nMSG: "), std::string::npos);
 }
 
+std::string lcmBytes(const point_cloud_t& m) {
+  std::string b(static_cast<size_t>(m.getEncodedSize()), '\0');
+  EXPECT_EQ(m.encode(b.data(), 0, static_cast<int>(b.size())), static_cast<int>(b.size()));
+  return b;
+}
+
+// From LIDAR_SCAN's bytes: the same PointCloud2 as from the decoded message.
+TEST(Ros1PointCloud, FromLcmBytesIsTheSameAsFromTheDecodedScan) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(-80, 80);
+  std::string a, b;
+  for (int n : {0, 1, 3, 5000}) {
+    std::vector<std::array<float, 4>> pts(n);
+    for (auto& p : pts) p = {u(rng), u(rng), u(rng) / 20, std::abs(u(rng)) / 80};
+    point_cloud_t m = cloud(987'654'321'000LL + n, 40 + n, pts);
+    m.sequence = n % 2 ? "0007" : "a-longer-sequence-name";
+    ros1::ScanId id;
+    const std::string bytes = lcmBytes(m);
+    const Refusal r = ros1::writePointCloud2FromLcm(bytes.data(), bytes.size(), "lidar", a, &id);
+    ASSERT_FALSE(r) << r.reason << ": " << r.detail;
+    ros1::writePointCloud2(m, "lidar", b);
+    EXPECT_EQ(a, b) << n << " points";
+    EXPECT_EQ(id.frame, 40 + n);
+    EXPECT_EQ(id.utime, 987'654'321'000LL + n);
+  }
+}
+
+// A scan the guard refuses is refused from its bytes too, for the same reason and detail.
+TEST(Ros1PointCloud, FromLcmBytesRefusesWhatTheGuardRefuses) {
+  const point_cloud_t good = cloud(1'000'000, 3, {{1, 2, 3, 0.5f}, {4, 5, 6, 0.25f}, {7, 8, 9, 1}});
+  std::vector<std::pair<std::string, std::string>> cases;  // what, bytes
+  point_cloud_t m = good;
+  m.z[2] = std::numeric_limits<float>::quiet_NaN();
+  cases.push_back({"NaN z", lcmBytes(m)});
+  m = good;
+  m.intensity[1] = std::numeric_limits<float>::infinity();
+  cases.push_back({"infinite intensity", lcmBytes(m)});
+  m = good;
+  m.frame = kMaxFrame + 1;
+  cases.push_back({"frame out of range", lcmBytes(m)});
+  m = good;
+  m.utime = -1;
+  cases.push_back({"negative utime", lcmBytes(m)});
+  cases.push_back({"truncated", lcmBytes(good).substr(0, 40)});
+  cases.push_back({"trailing byte", lcmBytes(good) + "x"});
+  std::string wrong_hash = lcmBytes(good);
+  wrong_hash[0] ^= 1;
+  cases.push_back({"another type", wrong_hash});
+  for (const auto& [what, bytes] : cases) {
+    point_cloud_t decoded;
+    const Refusal guard = decodeChecked(bytes.data(), bytes.size(), &decoded);
+    ASSERT_TRUE(guard) << what << ": the guard accepts it";
+    std::string out;
+    ros1::ScanId id;
+    const Refusal ours = ros1::writePointCloud2FromLcm(bytes.data(), bytes.size(), "lidar", out, &id);
+    EXPECT_EQ(ours.reason, guard.reason) << what;
+    EXPECT_EQ(ours.detail, guard.detail) << what;
+    const Refusal head = ros1::checkScanHeader(bytes.data(), bytes.size(), &id);
+    if (what.find("NaN") == std::string::npos && what.find("infinite") == std::string::npos)
+      EXPECT_EQ(head.reason, guard.reason) << what;  // the header check sees all but the points
+    else
+      EXPECT_FALSE(head) << what;
+  }
+}
+
 // The converter picks the encoding: JSON for MCAP files, PointCloud2 for the live bridge.
 TEST(Ros1PointCloud, ConverterWritesTheScanInTheChosenEncoding) {
   const point_cloud_t m = cloud(2'000'000, 3, {{1, 2, 3, 0.5f}});
@@ -150,8 +216,9 @@ TEST(Ros1PointCloud, ConverterWritesTheScanInTheChosenEncoding) {
   opt.scan_encoding = ScanEncoding::kRos1;
   Converter ros(Channels(), opt), json;
   std::vector<Output> a, b;
-  ros.add(m, a);
-  json.add(m, b);
+  const std::string bytes = lcmBytes(m);
+  ASSERT_FALSE(ros.convert("LIDAR_SCAN", bytes.data(), bytes.size(), a));
+  ASSERT_FALSE(json.convert("LIDAR_SCAN", bytes.data(), bytes.size(), b));
   ASSERT_EQ(a.size(), 1u);
   ASSERT_EQ(b.size(), 1u);
   const SchemaText& s = *ros.topics()[a[0].topic].schema;

@@ -65,18 +65,35 @@ int run(int argc, char** argv) {
   conv.setWanted([&](size_t topic) { return server.subscribed(static_cast<uint32_t>(topic + 1)); });
 
   std::vector<foxglove::Output> out;
-  auto forward = [&](const auto& msg) {
-    out.clear();
-    conv.add(msg, out);
+  auto publishOut = [&] {
     const uint64_t t = nowNs();
     for (auto& o : out)
       server.publish(static_cast<uint32_t>(o.topic + 1), t, std::make_shared<std::string>(std::move(o.bytes)));
   };
-  // A frame is handled when its scan is (built and queued, or skipped when nobody watches).
-  node.subscribe<point_cloud_t>(channels.scan, [&](const point_cloud_t& m) {
+  auto forward = [&](const auto& msg) {
+    out.clear();
+    conv.add(msg, out);
+    publishOut();
+  };
+  // A frame is handled when its scan is (built and queued, or skipped when nobody watches). The
+  // scan's bytes go to the converter as they came (after the node's envelope check): it checks
+  // them as the message guard does and writes the PointCloud2 from them in one pass.
+  node.subscribeRaw(channels.scan, [&](const lcm::ReceiveBuffer& rb) {
     const double t0 = threadCpuMs();
-    forward(m);
-    node.status().frameDone(m.frame, threadCpuMs() - t0);
+    out.clear();
+    int frame = -1;
+    Refusal why;
+    try {
+      why = conv.addScan(rb.data, rb.data_size, out, &frame);
+    } catch (const std::exception& e) {  // counted like a typed subscription's handler exception
+      why = {"handler_exception", e.what()};
+    }
+    if (why) {
+      node.status().refused(channels.scan, why);
+      return;
+    }
+    publishOut();
+    node.status().frameDone(frame, threadCpuMs() - t0);
   });
   node.subscribe<detections_t>(channels.detections, [&](const detections_t& m) { forward(m); });
   node.subscribe<ground_truth_t>(channels.ground_truth, [&](const ground_truth_t& m) { forward(m); });

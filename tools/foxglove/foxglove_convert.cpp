@@ -97,7 +97,7 @@ Refusal Converter::convert(const std::string& channel, const void* data, size_t 
     add(msg, out);
     return {};
   };
-  if (channel == channels_.scan) return as(point_cloud_t());
+  if (channel == channels_.scan) return addScan(data, size, out);
   if (channel == channels_.detections) return as(detections_t());
   if (channel == channels_.ground_truth) return as(ground_truth_t());
   if (channel == channels_.odometry) return as(odometry_t());
@@ -105,6 +105,28 @@ Refusal Converter::convert(const std::string& channel, const void* data, size_t 
   if (channel == channels_.slot_state) return as(slot_state_t());
   if (channel == channels_.status) return as(process_status_t());
   addRaw(channel, data, size, out);
+  return {};
+}
+
+Refusal Converter::addScan(const void* data, size_t size, std::vector<Output>& out, int* frame) {
+  if (opt_.scan_encoding == ScanEncoding::kJson) {
+    point_cloud_t m;
+    if (Refusal r = decodeChecked(data, size, &m)) return r;
+    if (frame) *frame = m.frame;
+    add(m, out);
+    return {};
+  }
+  ros1::ScanId id;
+  if (!wanted(kScan)) {
+    const Refusal r = ros1::checkScanHeader(data, size, &id);
+    if (!r && frame) *frame = id.frame;
+    return r;
+  }
+  Output o{kScan, {}, -1};
+  if (Refusal r = ros1::writePointCloud2FromLcm(data, size, kLidarFrame, o.bytes, &id)) return r;
+  if (frame) *frame = id.frame;
+  o.utime = id.utime;
+  out.push_back(std::move(o));
   return {};
 }
 

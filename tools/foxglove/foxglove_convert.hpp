@@ -91,6 +91,11 @@ class Converter {
   // the refusal (nothing appended) when it does not decode or is not valid; a channel of no
   // known type is passed through as dlslot.LcmMessage.
   Refusal convert(const std::string& channel, const void* data, size_t size, std::vector<Output>& out);
+  // A scan from its LCM bytes, checked as the guard checks it (refused: nothing appended). In
+  // ROS 1 encoding the points go from the LCM bytes to the PointCloud2 in one pass (no decoded
+  // message in between), and a scan no one wants is only checked up to its points. `frame` (when
+  // given) gets the scan's frame.
+  Refusal addScan(const void* data, size_t size, std::vector<Output>& out, int* frame = nullptr);
   // The typed entry points (the bridge's typed subscriptions call these).
   void add(const point_cloud_t& m, std::vector<Output>& out);
   void add(const detections_t& m, std::vector<Output>& out);

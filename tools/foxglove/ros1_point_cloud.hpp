@@ -14,6 +14,7 @@
 #include <string>
 #include <string_view>
 
+#include "dlslot/message_guard.hpp"
 #include "dlslot/point_cloud_t.hpp"
 
 namespace dlslot::foxglove::ros1 {
@@ -58,5 +59,20 @@ inline constexpr uint32_t kPointStep = 16;
 // intensity (float32 at 0, 4, 8, 12), little-endian, point_step 16, row_step 16 * width, the
 // points, is_dense (the message guard lets no non-finite point through).
 void writePointCloud2(const point_cloud_t& scan, std::string_view frame_id, std::string& out);
+
+// The same PointCloud2 straight from LIDAR_SCAN's LCM bytes (an encoded point_cloud_t), in one
+// pass over the points: lcm-gen's decoder would first copy them into four vectors, one byte at a
+// time, and the guard would read them once more for finiteness. The message is checked as the
+// guard checks it (message_guard.hpp): its layout (checkLayout), its frame and utime (checkContent
+// on its scalar fields) and every point finite, with the guard's refusal reasons; on a refusal
+// `out` holds nothing meant for use. `id` gets the scan's frame and utime.
+struct ScanId {
+  int frame = -1;
+  int64_t utime = -1;
+};
+Refusal writePointCloud2FromLcm(const void* data, size_t size, std::string_view frame_id, std::string& out, ScanId* id);
+// Only the checks of writePointCloud2FromLcm short of the points (layout, frame, utime): for a
+// scan nobody watches.
+Refusal checkScanHeader(const void* data, size_t size, ScanId* id);
 
 }  // namespace dlslot::foxglove::ros1

@@ -267,12 +267,17 @@ void Server::publish(uint32_t channel, uint64_t time_ns, std::shared_ptr<std::st
   bool any = false;
   {
     std::lock_guard<std::mutex> lock(s.mu);
+    // The last subscriber's queue gets the caller's reference itself: once queued, the queues
+    // hold every reference, so the client that sends the message last can take its bytes over.
+    std::pair<Impl::Client*, uint32_t> last{nullptr, 0};
     for (auto& [h, c] : s.clients) {
       const auto sub = c.subscription_of_channel.find(channel);
       if (sub == c.subscription_of_channel.end()) continue;
-      c.queue.push({sub->second, time_ns, payload});
-      any = true;
+      if (last.first) last.first->queue.push({last.second, time_ns, payload});
+      last = {&c, sub->second};
     }
+    if (last.first) last.first->queue.push({last.second, time_ns, std::move(payload)});
+    any = last.first != nullptr;
   }
   if (any && !s.wake_pending.exchange(true)) asio::post(s.ws.get_io_service(), [&s] { s.pump(); });
 }

@@ -87,8 +87,8 @@ void printSummary(const Mapper& mapper, const std::string& out, const std::vecto
               mapper.loops().accepted(), mapper.loops().rejected());
   std::printf("  keyframe thread: %d scans deferred (it was %zu keyframes behind at most, bound %d)\n",
               mapper.keyframesDeferred(), mapper.maxBacklog(), mapper.config().max_backlog_keyframes);
-  std::printf("  per keyframe: decoding + removal + map %.2f ms mean; loop thread (descriptor, search, verification, graph) %.2f ms "
-              "mean, %.2f p95, %.1f max\n",
+  std::printf("  per keyframe, CPU: decoding + removal + map %.2f ms mean; loop thread (descriptor, search, verification, "
+              "graph) %.2f ms mean, %.2f p95, %.1f max\n",
               mapper.keyframes().empty() ? 0.0 : mapper.keyframeMs() / mapper.keyframes().size(), loop.mean(),
               loop.percentile(95), loop.max());
   for (const LoopEvent& e : mapper.loops().allEvents())

@@ -93,7 +93,7 @@ class Mapper {
   Pose mapFromWorld() const;
   LoopCloser& loops() { return *loops_; }
   const LoopCloser& loops() const { return *loops_; }
-  double keyframeMs() const { return keyframe_ms_; }  // total time committing keyframes (decoding included)
+  double keyframeMs() const { return keyframe_ms_; }  // total CPU time committing keyframes (decoding included)
   int keyframesDeferred() const { return deferred_; }
   const MapperConfig& config() const { return config_; }
   // Why a worker thread does not run at idle priority when asked to (empty: it does).

@@ -99,6 +99,8 @@ class Mapper {
   // Why a worker thread does not run at idle priority when asked to (empty: it does).
   std::vector<std::string> priorityErrors() const;
   size_t maxBacklog() const { return committer_->maxBacklog(); }
+  // CPU milliseconds used so far by the keyframe and loop-closure threads (0 inline).
+  double workerCpuMs() const { return committer_->cpuMs() + loops_->worker().cpuMs(); }
 
  private:
   struct Pending {

@@ -12,7 +12,6 @@
 // it heard as refused. With --insecure the run still finishes with every real frame handled, and
 // the injected messages are counted (refused by the content and frame-order checks).
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 #include <sys/stat.h>
 
 #include <filesystem>
@@ -22,11 +21,11 @@
 #include <regex>
 #include <set>
 #include <sstream>
-#include <thread>
 
 #include "dlslot/frame_accounting.hpp"
 #include "dlslot/message_auth.hpp"
 #include "dlslot/node.hpp"
+#include "bus_peer.hpp"
 #include "message_samples.hpp"
 #include "process_harness.hpp"
 
@@ -38,9 +37,6 @@ namespace {
 
 constexpr int kFrames = 16;
 constexpr int kInjectAt = 6;  // injected after the SLOT_STATE of this frame
-
-const std::vector<std::string> kFrameChannels = {"LIDAR_SCAN", "DETECTIONS", "GROUND_TRUTH",
-                                                 "ODOMETRY",   "ASSOCIATIONS", "SLOT_STATE"};
 
 // The LCM-encoded message inside an envelope (or the bytes themselves), for its frame number.
 int frameOf(const Bytes& b) {
@@ -56,28 +52,21 @@ Bytes badBoxes(int frame) {
   return encode(d);
 }
 
+// Remembers the run's messages of frames 0-2; after the SLOT_STATE of kInjectAt sends cases 1-3.
 struct Injector {
-  lcm::LCM* lcm = nullptr;
   std::map<std::string, std::map<int, Bytes>> seen;  // channel -> frame -> the run's bytes
-  std::map<std::string, int> sent;                   // channel -> injected messages
   bool done = false;
 
-  void send(const std::string& channel, const Bytes& b) {
-    ASSERT_EQ(lcm->publish(channel, b.data(), static_cast<unsigned>(b.size())), 0);
-    ++sent[channel];
-    // Paced so the receivers' buffers hold them (losses are not what this test is about).
-    std::this_thread::sleep_for(std::chrono::milliseconds(b.size() > 100000 ? 40 : 3));
-  }
-  void onMessage(const std::string& channel, const Bytes& b) {
+  void onMessage(BusPeer& peer, const std::string& channel, const Bytes& b) {
     if (done) return;  // our own messages come back too
     const int f = frameOf(b);
     if (f >= 0 && f <= 2 && !seen[channel].count(f)) seen[channel][f] = b;
     if (channel != "SLOT_STATE" || f != kInjectAt) return;
     done = true;
-    send("DETECTIONS", badBoxes(500));                       // case 1
-    for (int g = 2001; g <= 2004; ++g) send("DETECTIONS", badBoxes(g));  // case 2
-    for (const std::string& ch : kFrameChannels)              // case 3
-      for (const auto& [frame, bytes] : seen[ch]) send(ch, bytes);
+    peer.send("DETECTIONS", badBoxes(500));                       // case 1
+    for (int g = 2001; g <= 2004; ++g) peer.send("DETECTIONS", badBoxes(g));  // case 2
+    for (const std::string& ch : kFrameChannels)                   // case 3
+      for (const auto& [frame, bytes] : seen[ch]) peer.send(ch, bytes);
   }
 };
 
@@ -90,29 +79,17 @@ struct RunResult {
 RunResult runWithInjector(const std::string& data, const std::string& out, std::vector<std::string> extra,
                           bool inject) {
   Injector injector;
-  lcm::LCM lcm;  // declared after the injector: unsubscribed before it goes
-  EXPECT_TRUE(lcm.good());
-  injector.lcm = &lcm;
-  std::vector<lcm::Subscription*> subs;
-  if (inject)
-    for (const std::string& ch : kFrameChannels)
-      subs.push_back(lcm.subscribeFunction<Injector*>(
-          ch,
-          [](const lcm::ReceiveBuffer* rbuf, const std::string& channel, Injector* in) {
-            const auto* d = static_cast<const uint8_t*>(rbuf->data);
-            in->onMessage(channel, Bytes(d, d + rbuf->data_size));
-          },
-          &injector));
+  BusPeer peer([&](BusPeer& p, const std::string& channel, const Bytes& b) {
+    if (inject) injector.onMessage(p, channel, b);
+  });
   std::vector<std::string> args = {bin("dlslot-run"), "--config", config(), "--kitti", data, "--detections",
                                    data + "/detections/sim", "--out", out, "--quiet"};
   args.insert(args.end(), extra.begin(), extra.end());
   ChildProcess run(args, out + ".log");
-  while (run.running()) lcm.handleTimeout(20);
-  for (lcm::Subscription* s : subs) lcm.unsubscribe(s);
   RunResult r;
-  r.code = run.wait(0);
+  r.code = peer.listenUntilExit(run);
   r.text = run.output();
-  r.sent = injector.sent;
+  r.sent = peer.sent;
   if (inject) {
     EXPECT_TRUE(injector.done) << "the run never reached frame " << kInjectAt << "\n" << r.text;
   }

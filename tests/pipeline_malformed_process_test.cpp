@@ -5,14 +5,13 @@
 // log (dlslot-eval inside dlslot-run, dlslot-backend --offline, dlslot-renderer --log) skip and
 // count the same events.
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
-#include <thread>
 
+#include "bus_peer.hpp"
 #include "dlslot/node.hpp"
 #include "message_samples.hpp"
 #include "dlslot/frame_accounting.hpp"
@@ -27,9 +26,6 @@ namespace {
 constexpr int kFrames = 16;
 constexpr int kInjectAt = 6;     // the bad messages follow the real ones of this frame
 constexpr int kOldFrame = 4;     // re-sent as the out-of-order case
-
-const std::vector<std::string> kFrameChannels = {"LIDAR_SCAN", "DETECTIONS", "GROUND_TRUTH",
-                                                 "ODOMETRY",   "ASSOCIATIONS", "SLOT_STATE"};
 
 std::vector<Malformed> operator+(std::vector<Malformed> a, const std::vector<Malformed>& b) {
   a.insert(a.end(), b.begin(), b.end());
@@ -80,30 +76,22 @@ std::vector<Malformed> badMessagesFor(const std::string& channel, int f) {
 // that channel's malformed cases, then the real message again (duplicate) and the one of
 // kOldFrame (out of order). PROCESS_STATUS gets its cases after SLOT_STATE's.
 struct Injector {
-  lcm::LCM* lcm = nullptr;
   std::map<std::string, std::map<int, Bytes>> seen;
-  std::map<std::string, int> published;  // channel -> bad messages sent
   std::set<std::string> done;
 
-  void send(const std::string& channel, const Bytes& b) {
-    ASSERT_EQ(lcm->publish(channel, b.data(), static_cast<unsigned>(b.size())), 0);
-    ++published[channel];
-    // Paced, so the bad messages do not overflow the receivers' buffers (a loss test is not this one).
-    std::this_thread::sleep_for(std::chrono::milliseconds(b.size() > 100000 ? 30 : 2));
-  }
-  void onMessage(const std::string& channel, const Bytes& b) {
+  void onMessage(BusPeer& peer, const std::string& channel, const Bytes& b) {
     if (done.count(channel)) return;  // our own messages come back too
     const int f = frameOfEncoded(b.data(), b.size());
     if (f < 0 || f > kInjectAt) return;
     seen[channel][f] = b;
     if (f != kInjectAt) return;
     done.insert(channel);
-    for (const Malformed& m : badMessagesFor(channel, f)) send(channel, m.bytes);
-    send(channel, b);
+    for (const Malformed& m : badMessagesFor(channel, f)) peer.send(channel, m.bytes);
+    peer.send(channel, b);
     ASSERT_TRUE(seen[channel].count(kOldFrame)) << channel;
-    send(channel, seen[channel][kOldFrame]);
+    peer.send(channel, seen[channel][kOldFrame]);
     if (channel == "SLOT_STATE")
-      for (const Malformed& m : badMessagesFor("PROCESS_STATUS", 0)) send("PROCESS_STATUS", m.bytes);
+      for (const Malformed& m : badMessagesFor("PROCESS_STATUS", 0)) peer.send("PROCESS_STATUS", m.bytes);
   }
 };
 
@@ -140,25 +128,12 @@ TEST(PipelineMalformedProcess, EveryNodeSurvivesCountsEveryCaseAndThePipelineFin
     ASSERT_EQ(sim.wait(300), 0) << sim.output();
   }
   Injector injector;
-  lcm::LCM lcm;  // declared after the injector: unsubscribed before it goes
-  ASSERT_TRUE(lcm.good());
-  injector.lcm = &lcm;
-  std::vector<lcm::Subscription*> subs;
-  for (const std::string& ch : kFrameChannels)
-    subs.push_back(lcm.subscribeFunction<Injector*>(
-        ch,
-        [](const lcm::ReceiveBuffer* rbuf, const std::string& channel, Injector* in) {
-          const auto* d = static_cast<const uint8_t*>(rbuf->data);
-          in->onMessage(channel, Bytes(d, d + rbuf->data_size));
-        },
-        &injector));
+  BusPeer peer([&](BusPeer& p, const std::string& channel, const Bytes& b) { injector.onMessage(p, channel, b); });
 
   ChildProcess run({bin("dlslot-run"), "--config", config(), "--kitti", data, "--detections", data + "/detections/sim",
                     "--out", out + "/run", "--quiet", "--insecure"},  // the guard behind the envelope
                    out + "/run.log");
-  while (run.running()) lcm.handleTimeout(20);
-  for (lcm::Subscription* s : subs) lcm.unsubscribe(s);
-  const int code = run.wait(0);
+  const int code = peer.listenUntilExit(run);
   const std::string text = run.output();
   ASSERT_EQ(code, 0) << text;
   for (const std::string& ch : kFrameChannels) ASSERT_TRUE(injector.done.count(ch)) << ch << " never reached frame " << kInjectAt;
@@ -177,7 +152,7 @@ TEST(PipelineMalformedProcess, EveryNodeSurvivesCountsEveryCaseAndThePipelineFin
   // Each process counted exactly the cases it was sent on each channel it listens to.
   std::map<std::string, process_status_t> last;
   for (const process_status_t& s : decodeAll<process_status_t>(events["PROCESS_STATUS"])) last[s.name] = s;
-  const auto sent = [&](const std::string& ch) { return static_cast<int64_t>(injector.published.at(ch)); };
+  const auto sent = [&](const std::string& ch) { return static_cast<int64_t>(peer.sent.at(ch)); };
   const std::map<std::string, std::vector<std::string>> listens = {
       {"odometry", {"LIDAR_SCAN", "DETECTIONS"}},
       {"tracker", {"DETECTIONS", "ODOMETRY"}},
@@ -213,7 +188,7 @@ TEST(PipelineMalformedProcess, EveryNodeSurvivesCountsEveryCaseAndThePipelineFin
   // The evaluator (run by dlslot-run) skipped every bad event of the log and said so.
   EXPECT_NE(text.find("events refused and skipped"), std::string::npos) << text;
   std::cout << "[ malformed ] " << pairs + 3 << " (process, channel) pairs live; cases per channel:";
-  for (const auto& [ch, n] : injector.published) std::cout << " " << ch << "=" << n;
+  for (const auto& [ch, n] : peer.sent) std::cout << " " << ch << "=" << n;
   std::cout << "\n";
 
   // Offline readers of the same log: the backend's replay and the renderer's log mode.

@@ -63,3 +63,35 @@ TEST(RunStallProcess, StoppedOdometryIsReportedByName) {
   std::cout << "[ stall ] odometry SIGSTOPped; the launcher reported it by name after " << after_s << " s (exit "
             << code << ")\n";
 }
+
+// In lockstep a process that is only slow (a loaded machine, a sanitizer build) changes nothing:
+// no later frame comes before this one is solved, so the backend and the tracker wait for its
+// input as long as the player's lockstep timeout allows (0.4 of it each) instead of going on
+// without it. The odometry is stopped for 1.5 s, longer than the backend's own live wait
+// (backend.join_timeout_s, 1 s), shorter than the lockstep's (0.4 x 5 s).
+TEST(RunStallProcess, SlowOdometryInLockstepLosesNothing) {
+  ASSERT_TRUE(insidePrivateNetwork());
+  const std::string out = scratchDir();
+  ChildProcess sim({bin("dlslot-sim"), "--scenario", "intersection", "--frames", "30", "--seed", "3", "--out",
+                    out + "/data"},
+                   out + "/sim.log");
+  ASSERT_EQ(sim.wait(300), 0) << sim.output();
+  ChildProcess run({bin("dlslot-run"), "--config", config(), "--kitti", out + "/data", "--detections",
+                    out + "/data/detections/sim", "--out", out + "/run", "--quiet", "--no-render", "--no-map",
+                    "--no-eval"},
+                   out + "/run.log");
+  for (int i = 0; i < 600 && !fs::exists(out + "/run/logs/player.log"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  ASSERT_TRUE(run.running()) << run.output();
+  const pid_t odometry = childNamed(run.pid(), "dlslot-odometry");
+  ASSERT_GT(odometry, 0) << run.output();
+  ASSERT_EQ(kill(odometry, SIGSTOP), 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  ASSERT_EQ(kill(odometry, SIGCONT), 0);
+  const int code = run.wait(120);
+  const std::string text = run.output();
+  EXPECT_EQ(code, 0) << text;
+  EXPECT_NE(text.find("solved without odometry 0, without associations 0"), std::string::npos) << text;
+  EXPECT_NE(text.find("0 frames lost"), std::string::npos) << text;
+}

@@ -1,6 +1,7 @@
 #include "mapper/loop_closer.hpp"
 
 #include <chrono>
+#include <memory>
 #include <unordered_set>
 
 #include "dlslot/voxel_key.hpp"
@@ -22,59 +23,22 @@ PointCloud voxelDownsample(const PointCloud& points, double voxel_m) {
   return out;
 }
 
-LoopCloser::LoopCloser(const LoopConfig& config, bool threaded) : config_(config), threaded_(threaded) {
+LoopCloser::LoopCloser(const LoopConfig& config, bool threaded, size_t capacity, bool idle_priority)
+    : config_(config), worker_("loop closure", threaded, capacity, idle_priority) {
   sc_params_.rings = config.rings;
   sc_params_.sectors = config.sectors;
   sc_params_.max_radius_m = config.max_radius_m;
-  if (threaded_) worker_ = std::thread([this] { work(); });
 }
 
-LoopCloser::~LoopCloser() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stop_ = true;
-  }
-  wake_.notify_all();
-  if (worker_.joinable()) worker_.join();
-}
+LoopCloser::~LoopCloser() = default;
 
 void LoopCloser::add(KeyframeInput kf) {
-  if (!threaded_) {
-    process(std::move(kf));
-    return;
-  }
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    queue_.push_back(std::move(kf));
-  }
-  wake_.notify_one();
+  // std::function needs a copyable job: the keyframe's points travel in a shared pointer.
+  auto shared = std::make_shared<KeyframeInput>(std::move(kf));
+  worker_.post([this, shared] { process(std::move(*shared)); });
 }
 
-void LoopCloser::drain() {
-  if (!threaded_) return;
-  std::unique_lock<std::mutex> lock(mutex_);
-  idle_.wait(lock, [this] { return queue_.empty() && !busy_; });
-}
-
-void LoopCloser::work() {
-  for (;;) {
-    KeyframeInput kf;
-    {
-      std::unique_lock<std::mutex> lock(mutex_);
-      wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
-      if (queue_.empty()) return;  // stopping
-      kf = std::move(queue_.front());
-      queue_.pop_front();
-      busy_ = true;
-    }
-    process(std::move(kf));
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      busy_ = false;
-    }
-    idle_.notify_all();
-  }
-}
+void LoopCloser::drain() { worker_.drain(); }
 
 void LoopCloser::process(KeyframeInput in) {
   const auto start = std::chrono::steady_clock::now();

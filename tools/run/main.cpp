@@ -376,15 +376,27 @@ int runPipeline(int argc, char** argv) {
     pipeline.insert(pipeline.begin(), "mapper");
     sup.start("mapper", args(bin + "/dlslot-mapper", {"--out", out}), logs + "/mapper.log");
   }
-  sup.start("backend", args(bin + "/dlslot-backend", {"--mode", ms.backend}), logs + "/backend.log");
+  // In lockstep no later frame comes before this one is solved, so the tracker and the backend may
+  // wait for a frame's inputs as long as the player waits for its SLOT_STATE: going on without an
+  // input that is merely slow (a loaded machine, a sanitizer build) would change the results. Their
+  // two waits can come one after the other (the tracker's for ODOMETRY, then the backend's for
+  // ASSOCIATIONS), and both must end before the player's: 0.4 of it each.
+  std::vector<std::string> join;
+  if (!(speed > 0)) {
+    const double player_wait = YAML::LoadFile(config)["player"]["lockstep_timeout_s"].as<double>(5.0);
+    join = {"--join-timeout", std::to_string(0.4 * player_wait)};
+  }
+  std::vector<std::string> backend_args = {"--mode", ms.backend};
+  backend_args.insert(backend_args.end(), join.begin(), join.end());
+  sup.start("backend", args(bin + "/dlslot-backend", backend_args), logs + "/backend.log");
   // Lockstep with two frames in flight: the player publishes frame t+1 once SLOT_STATE carried
   // t-1, so the odometry of t+1 runs while the tracker and the backend finish t, and the tracker
   // waits for SLOT_STATE t before associating t+1 (slot_state_gate.hpp): every process sees its
   // inputs in frame order and the tracker the optimized poses of strict lockstep, so the results
   // are the same bytes (pipeline_overlap test). --in-flight 1: strict lockstep.
-  sup.start("tracker", args(bin + "/dlslot-tracker", speed > 0 ? std::vector<std::string>{}
-                                                                  : std::vector<std::string>{"--follow-slot-state"}),
-            logs + "/tracker.log");
+  std::vector<std::string> tracker_args = join;
+  if (!(speed > 0)) tracker_args.push_back("--follow-slot-state");
+  sup.start("tracker", args(bin + "/dlslot-tracker", tracker_args), logs + "/tracker.log");
   sup.start("odometry", args(bin + "/dlslot-odometry", {"--mode", ms.odometry}), logs + "/odometry.log");
   if (geometric) {
     pipeline.push_back("detector");

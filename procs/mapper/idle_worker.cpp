@@ -2,6 +2,7 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <time.h>
 
 #include <algorithm>
 #include <cstring>
@@ -74,6 +75,16 @@ size_t IdleWorker::maxBacklog() const {
 std::string IdleWorker::priorityError() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return priority_error_;
+}
+
+double IdleWorker::cpuMs() const {
+  if (!threaded_) return 0;
+  clockid_t clock;
+  timespec ts{};
+  if (pthread_getcpuclockid(const_cast<std::thread&>(thread_).native_handle(), &clock) != 0 ||
+      clock_gettime(clock, &ts) != 0)
+    return 0;
+  return 1e3 * static_cast<double>(ts.tv_sec) + 1e-6 * static_cast<double>(ts.tv_nsec);
 }
 
 std::vector<std::string> IdleWorker::takeErrors() {

@@ -38,6 +38,8 @@ class IdleWorker {
   size_t capacity() const { return capacity_; }
   // Empty when the thread runs at the priority asked for; else why not (e.g. not permitted).
   std::string priorityError() const;
+  // CPU milliseconds the thread has used so far (0 inline).
+  double cpuMs() const;
   // What jobs threw (a job's exception is caught on the thread, kept here, and the next job runs).
   std::vector<std::string> takeErrors();
 

@@ -58,7 +58,7 @@ class LoopCloser {
   std::vector<LoopEvent> allEvents() const;
   int accepted() const;
   int rejected() const;
-  // Milliseconds per keyframe spent here (descriptor, search, verification, optimization).
+  // CPU milliseconds per keyframe spent here (descriptor, search, verification, optimization).
   std::vector<double> timesMs() const;
 
  private:

@@ -1,8 +1,10 @@
 #include "mapper/mapper.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <memory>
+
+#include "dlslot/cpu_clock.hpp"
+#include "mapper/box_cutter.hpp"
 
 namespace dlslot::mapper {
 
@@ -109,7 +111,8 @@ std::vector<std::string> Mapper::takeErrors() {
 }
 
 void Mapper::commit(Pending& p, const std::vector<Box>& world_boxes) {
-  const auto start = std::chrono::steady_clock::now();
+  // CPU time of this thread: at idle priority the wall time mostly counts waiting for a core.
+  const double start = threadCpuMs();
   PointCloud scan;
   if (p.load_scan) {
     try {
@@ -134,34 +137,15 @@ void Mapper::commit(Pending& p, const std::vector<Box>& world_boxes) {
       ++n;
     }
   }
+  // The removal boxes in the lidar frame (box_cutter.hpp).
   const Pose lidar_from_world = p.pose.inverse();
-  // The removal boxes in the lidar frame, with their heading's sine and cosine and the radius of
-  // their footprint worked out once: the test runs for every point of the keyframe against every
-  // box (Box::contains's test, in float, after a cheap footprint-circle rejection).
-  struct Cut {
-    Eigen::Vector3f center, half;
-    float c, s, reach2;
-  };
-  std::vector<Cut> cuts;
-  for (const Box& world_box : world_boxes) {
-    const Box b = world_box.transformed(lidar_from_world);
-    const float reach = 0.5f * static_cast<float>(b.size.head<2>().norm());
-    cuts.push_back({b.center.cast<float>(), 0.5f * b.size.cast<float>(), static_cast<float>(std::cos(b.yaw)),
-                    static_cast<float>(std::sin(b.yaw)), reach * reach});
-  }
+  std::vector<Box> boxes;
+  boxes.reserve(world_boxes.size());
+  for (const Box& b : world_boxes) boxes.push_back(b.transformed(lidar_from_world));
+  const BoxCutter cutter(boxes, config_.max_range_m);
   PointCloud kept(4, n), gone(4, n);
   Eigen::Index nk = 0, ng = 0;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    bool inside = false;
-    for (const Cut& k : cuts) {
-      const Eigen::Vector3f d = scan.col(i).head<3>() - k.center;
-      if (d.head<2>().squaredNorm() > k.reach2) continue;
-      inside = std::abs(k.c * d.x() + k.s * d.y()) <= k.half.x() && std::abs(-k.s * d.x() + k.c * d.y()) <= k.half.y() &&
-               std::abs(d.z()) <= k.half.z();
-      if (inside) break;
-    }
-    (inside ? gone.col(ng++) : kept.col(nk++)) = scan.col(i);
-  }
+  for (Eigen::Index i = 0; i < n; ++i) (cutter.inside(scan.col(i).head<3>()) ? gone.col(ng++) : kept.col(nk++)) = scan.col(i);
   kept.conservativeResize(4, nk);
   gone.conservativeResize(4, ng);
   const int id = static_cast<int>(keyframes_.size());
@@ -172,7 +156,7 @@ void Mapper::commit(Pending& p, const std::vector<Box>& world_boxes) {
   keyframe_count_ = static_cast<int>(keyframes_.size());
   map_voxels_ = map_.size();
   removed_voxels_ = removed_.size();
-  keyframe_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  keyframe_ms_ += threadCpuMs() - start;
   // Only a keyframe that saw something new keeps its registration cloud for later loops: one
   // that adds (almost) no voxel to the map is a place already held by earlier keyframes, so the
   // loop closer's memory, like the map's, stops growing when the map does (driving in circles,

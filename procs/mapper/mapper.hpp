@@ -93,12 +93,14 @@ class Mapper {
   Pose mapFromWorld() const;
   LoopCloser& loops() { return *loops_; }
   const LoopCloser& loops() const { return *loops_; }
-  double keyframeMs() const { return keyframe_ms_; }  // total time committing keyframes (decoding included)
+  double keyframeMs() const { return keyframe_ms_; }  // total CPU time committing keyframes (decoding included)
   int keyframesDeferred() const { return deferred_; }
   const MapperConfig& config() const { return config_; }
   // Why a worker thread does not run at idle priority when asked to (empty: it does).
   std::vector<std::string> priorityErrors() const;
   size_t maxBacklog() const { return committer_->maxBacklog(); }
+  // CPU milliseconds used so far by the keyframe and loop-closure threads (0 inline).
+  double workerCpuMs() const { return committer_->cpuMs() + loops_->worker().cpuMs(); }
 
  private:
   struct Pending {

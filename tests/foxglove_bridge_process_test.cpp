@@ -1,6 +1,7 @@
 // dlslot-foxglove started for real inside the test's network namespace, fed LCM messages, and
 // read by npm's `ws` client (tests/js/ws_client.cjs) speaking the Foxglove WebSocket protocol:
-// it must advertise every topic, deliver scans and tracks to a subscriber, and, for a client
+// it must advertise every topic, deliver scans (ROS 1 PointCloud2, decoded by Foxglove's own ROS 1
+// reader with the advertised definition) and tracks (JSON) to a subscriber, and, for a client
 // that stops reading, drop that client's oldest messages (counted in its status) while it goes
 // on handling every frame.
 #include <gtest/gtest.h>
@@ -107,8 +108,9 @@ YAML::Node lastJsonLine(const std::string& text) {
 
 TEST(FoxgloveBridge, AdvertisesEveryTopicAndDeliversScansAndTracksToAWsClient) {
   ASSERT_TRUE(insidePrivateNetwork());
-  ASSERT_TRUE(std::filesystem::exists(nodeModules() + "/ws/package.json"))
-      << "npm's ws is not installed in " << nodeModules() << ": run ./dlslot setup";
+  for (const char* package : {"ws", "@foxglove/rosmsg", "@foxglove/rosmsg-serialization"})
+    ASSERT_TRUE(std::filesystem::exists(nodeModules() + "/" + package + "/package.json"))
+        << "npm's " << package << " is not installed in " << nodeModules() << ": run ./dlslot setup";
   const std::string dir = scratchDir();
   const int port = 18765;
   Bridge bridge(dir, port, 32);
@@ -123,7 +125,7 @@ TEST(FoxgloveBridge, AdvertisesEveryTopicAndDeliversScansAndTracksToAWsClient) {
   EXPECT_EQ(r["errors"].size(), 0u) << client.output();
   EXPECT_EQ(r["serverInfo"]["name"].as<std::string>(), "dlslot-foxglove");
   const std::map<std::string, std::string> schemas = {
-      {"/lidar/points", "foxglove.PointCloud"},      {"/detections", "foxglove.SceneUpdate"},
+      {"/detections", "foxglove.SceneUpdate"},
       {"/ground_truth/boxes", "foxglove.SceneUpdate"}, {"/ground_truth/path", "foxglove.PosesInFrame"},
       {"/odometry/path", "foxglove.PosesInFrame"},   {"/tracker/associations", "foxglove.SceneUpdate"},
       {"/tf", "foxglove.FrameTransform"},            {"/slot/path", "foxglove.PosesInFrame"},
@@ -131,9 +133,35 @@ TEST(FoxgloveBridge, AdvertisesEveryTopicAndDeliversScansAndTracksToAWsClient) {
   for (const auto& [topic, schema] : schemas) {
     EXPECT_EQ(r["advertised"][topic]["schemaName"].as<std::string>(""), schema) << topic;
     EXPECT_EQ(r["advertised"][topic]["encoding"].as<std::string>(""), "json") << topic;
+    EXPECT_EQ(r["advertised"][topic]["schemaEncoding"].as<std::string>(""), "jsonschema") << topic;
   }
+  // The scan: binary, as ROS 1 PointCloud2, every point and field as published.
+  EXPECT_EQ(r["advertised"]["/lidar/points"]["schemaName"].as<std::string>(""), "sensor_msgs/PointCloud2");
+  EXPECT_EQ(r["advertised"]["/lidar/points"]["encoding"].as<std::string>(""), "ros1");
+  EXPECT_EQ(r["advertised"]["/lidar/points"]["schemaEncoding"].as<std::string>(""), "ros1msg");
   ASSERT_GE(r["topics"]["/lidar/points"]["received"].as<int>(), 5);
-  for (const auto& d : r["topics"]["/lidar/points"]["details"]) EXPECT_EQ(d["points"].as<int>(), 1000);
+  for (const auto& d : r["topics"]["/lidar/points"]["details"]) {
+    const int frame = d["seq"].as<int>();
+    const point_cloud_t sent = scan(frame, 1000);
+    EXPECT_EQ(d["points"].as<int>(), 1000);
+    EXPECT_EQ(d["frame_id"].as<std::string>(), "lidar");
+    EXPECT_EQ(d["stamp"][0].as<int64_t>(), sent.utime / 1000000) << "frame " << frame;
+    EXPECT_EQ(d["stamp"][1].as<int64_t>(), sent.utime % 1000000 * 1000) << "frame " << frame;
+    EXPECT_FALSE(d["is_bigendian"].as<bool>());
+    EXPECT_TRUE(d["is_dense"].as<bool>());
+    ASSERT_EQ(d["fields"].size(), 4u);
+    const char* names[4] = {"x", "y", "z", "intensity"};
+    for (int f = 0; f < 4; ++f) {
+      EXPECT_EQ(d["fields"][f][0].as<std::string>(), names[f]);
+      EXPECT_EQ(d["fields"][f][1].as<int>(), 4 * f);
+      EXPECT_EQ(d["fields"][f][2].as<int>(), 7);  // FLOAT32
+      EXPECT_EQ(d["fields"][f][3].as<int>(), 1);
+    }
+    for (const auto& [key, i] : {std::pair<const char*, int>{"first", 0}, {"last", 999}}) {
+      const float want[4] = {sent.x[i], sent.y[i], sent.z[i], sent.intensity[i]};
+      for (int f = 0; f < 4; ++f) EXPECT_EQ(d[key][f].as<float>(), want[f]) << key << " point, field " << names[f];
+    }
+  }
   ASSERT_GE(r["topics"]["/slot/tracks"]["received"].as<int>(), 5);
   const YAML::Node tracks = r["topics"]["/slot/tracks"]["details"][0];
   EXPECT_EQ(tracks["entities"].as<int>(), 2);

@@ -318,7 +318,7 @@ TEST(FoxgloveConvert, ScanIsAPackedFloat32PointCloudInTheLidarFrame) {
   conv.add(scan(2, 2), out);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(conv.topics()[out[0].topic].name, "/lidar/points");
-  const YAML::Node j = YAML::Load(out[0].json);
+  const YAML::Node j = YAML::Load(out[0].bytes);
   EXPECT_EQ(j["frame_id"].as<std::string>(), "lidar");
   EXPECT_EQ(j["point_stride"].as<int>(), 16);
   EXPECT_EQ(j["timestamp"]["sec"].as<int64_t>(), 1000);
@@ -340,7 +340,7 @@ TEST(FoxgloveConvert, SlotStateGivesTransformPathAndTracksWithRecentPaths) {
   }
   ASSERT_EQ(out.size(), 3u);
   std::map<std::string, YAML::Node> by;
-  for (const auto& o : out) by[conv.topics()[o.topic].name] = YAML::Load(o.json);
+  for (const auto& o : out) by[conv.topics()[o.topic].name] = YAML::Load(o.bytes);
   // world -> lidar, quaternion (w, x, y, z) written as x y z w.
   const YAML::Node tf = by["/tf"];
   EXPECT_EQ(tf["parent_frame_id"].as<std::string>(), "world");
@@ -368,7 +368,7 @@ TEST(FoxgloveConvert, UnwantedTopicsAreNotBuiltButStateIsKept) {
   conv.add(slotState(0, {1}), out);
   conv.add(slotState(1, {1}), out);
   ASSERT_EQ(out.size(), 2u);
-  EXPECT_EQ(YAML::Load(out[1].json)["poses"].size(), 2u);
+  EXPECT_EQ(YAML::Load(out[1].bytes)["poses"].size(), 2u);
 }
 
 TEST(FoxgloveLayout, TheShippedLayoutShowsTopicsTheConverterWrites) {

@@ -8,7 +8,7 @@ using namespace dlslot::foxglove;
 
 namespace {
 
-QueuedMessage msg(uint64_t t, size_t bytes) { return {1, t, std::make_shared<const std::string>(bytes, 'x')}; }
+QueuedMessage msg(uint64_t t, size_t bytes) { return {1, t, std::make_shared<std::string>(bytes, 'x')}; }
 
 TEST(ClientQueue, KeepsEverythingWithinTheBudgetInOrder) {
   ClientQueue q(100);

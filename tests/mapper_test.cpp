@@ -6,10 +6,15 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 
+#include <atomic>
+#include <chrono>
 #include <filesystem>
+#include <mutex>
+#include <thread>
 #include <random>
 #include <unordered_set>
 
+#include "mapper/idle_worker.hpp"
 #include "mapper/loop_verifier.hpp"
 #include "mapper/map_output.hpp"
 #include "mapper/mapper.hpp"
@@ -281,13 +286,10 @@ TEST(MapOutput, MapPcdReadsBackWithPclWithItsPointsAndBounds) {
   EXPECT_TRUE(binary);
 }
 
-TEST(Mapper, AMovingCarLeavesNoGhostAndTheStaticWorldStays) {
-  // A wall along the road and a car driving past the parked ego; the backend calls it dynamic.
-  MapperConfig config;
-  config.keyframe_distance_m = 0.5;
-  config.decision_delay_frames = 8;
-  config.loop.enabled = false;
-  Mapper mapper(config, false);
+// A wall along the road and a car driving past the ego (the backend calls it dynamic), fed to
+// `mapper` frame by frame: the car's points are given through a ScanLoader (decoded on demand)
+// on odd frames and directly on even ones; frame `bad` (if any) has a scan that does not decode.
+void feedCarScene(Mapper& mapper, int bad = -1) {
   for (int f = 0; f < 20; ++f) {
     MapperInput in;
     in.frame = f;
@@ -299,7 +301,12 @@ TEST(Mapper, AMovingCarLeavesNoGhostAndTheStaticWorldStays) {
     const double car_x = 5.0 + f * 2.0 - f * 1.0;  // the car, 1 m/s faster than the ego, 5 m ahead, lidar frame
     for (double dx = -2; dx <= 2; dx += 0.1)  // the body 0.15 m above the box's floor (wheels), to its top
       for (double dz = -0.6; dz <= 0.7; dz += 0.1) pts.emplace_back(car_x + dx, -3.5, dz - 1.0);
-    in.scan = toCloud(pts);
+    if (f == bad)
+      in.load_scan = [] () -> PointCloud { throw ScanRefused("bad_count", "points: 3 declared, 2 present"); };
+    else if (f % 2)
+      in.load_scan = [cloud = toCloud(pts)] { return cloud; };
+    else
+      in.scan = toCloud(pts);
     if (f % 4 != 2) {  // detector misses every fourth frame
       TrackSnapshot t;
       t.id = 7;
@@ -311,6 +318,19 @@ TEST(Mapper, AMovingCarLeavesNoGhostAndTheStaticWorldStays) {
     }
     mapper.add(in);
   }
+}
+
+MapperConfig carSceneConfig() {
+  MapperConfig config;
+  config.keyframe_distance_m = 0.5;
+  config.decision_delay_frames = 8;
+  config.loop.enabled = false;
+  return config;
+}
+
+TEST(Mapper, AMovingCarLeavesNoGhostAndTheStaticWorldStays) {
+  Mapper mapper(carSceneConfig(), false);
+  feedCarScene(mapper);
   mapper.finish();
   const PointCloud map = mapper.map().cloud(), removed = mapper.removed().cloud();
   int ghost = 0, wall = 0;
@@ -321,4 +341,82 @@ TEST(Mapper, AMovingCarLeavesNoGhostAndTheStaticWorldStays) {
   EXPECT_EQ(ghost, 0);
   EXPECT_GT(wall, 1000);
   EXPECT_GT(removed.cols(), 500);
+}
+
+TEST(Mapper, ItsIdlePriorityThreadsBuildTheSameMapAsInline) {
+  // Live, keyframes and loop closure run on SCHED_IDLE threads; finish() catches up. The map must
+  // be the inline one, voxel for voxel.
+  Mapper inline_mapper(carSceneConfig(), false), threaded(carSceneConfig(), true);
+  feedCarScene(inline_mapper);
+  feedCarScene(threaded);
+  inline_mapper.finish();
+  threaded.finish();
+  EXPECT_TRUE(threaded.priorityErrors().empty()) << threaded.priorityErrors().front();
+  ASSERT_EQ(threaded.keyframes().size(), inline_mapper.keyframes().size());
+  EXPECT_EQ(threaded.keyframes().size(), 20u);
+  EXPECT_EQ(threaded.snapshot().keyframes, 20);
+  const PointCloud a = inline_mapper.map().cloud(), b = threaded.map().cloud();
+  ASSERT_EQ(a.cols(), b.cols());
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(threaded.snapshot().map_voxels, static_cast<size_t>(a.cols()));
+  EXPECT_EQ(threaded.keyframesDeferred(), 0);
+}
+
+TEST(Mapper, AScanThatDoesNotDecodeIsRefusedAndCountedNotMapped) {
+  Mapper mapper(carSceneConfig(), true);
+  feedCarScene(mapper, /*bad=*/5);
+  mapper.finish();
+  const std::vector<ScanRefused> refused = mapper.takeRefusedScans();
+  ASSERT_EQ(refused.size(), 1u);
+  EXPECT_EQ(refused[0].reason, "bad_count");
+  EXPECT_EQ(mapper.keyframes().size(), 19u);
+  for (const KeyframeRecord& k : mapper.keyframes()) EXPECT_NE(k.frame, 5);
+  EXPECT_TRUE(mapper.takeRefusedScans().empty());  // taken once
+}
+
+TEST(IdleWorker, RunsJobsInOrderBoundsItsQueueAndKeepsWhatAJobThrew) {
+  IdleWorker worker("test", true, 2, true);
+  std::mutex gate;
+  std::unique_lock<std::mutex> hold(gate);  // the first job waits on this
+  std::vector<int> order;
+  std::mutex order_mutex;
+  auto record = [&](int i) {
+    std::lock_guard<std::mutex> lock(order_mutex);
+    order.push_back(i);
+  };
+  worker.post([&] {
+    std::lock_guard<std::mutex> wait(gate);
+    record(0);
+  });
+  while (worker.backlog() != 0) std::this_thread::yield();  // the first job has started
+  worker.post([&] { record(1); });
+  worker.post([&] { throw std::runtime_error("boom"); });
+  EXPECT_EQ(worker.backlog(), 2u);
+  // The queue is full: a third post blocks until the held job lets a slot free.
+  std::atomic<bool> posted{false};
+  std::thread poster([&] {
+    worker.post([&] { record(3); });
+    posted = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_FALSE(posted);
+  hold.unlock();
+  poster.join();
+  worker.drain();
+  EXPECT_TRUE(posted);
+  EXPECT_EQ(order, (std::vector<int>{0, 1, 3}));
+  EXPECT_EQ(worker.maxBacklog(), 2u);
+  const std::vector<std::string> errors = worker.takeErrors();
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_NE(errors[0].find("boom"), std::string::npos);
+  EXPECT_TRUE(worker.priorityError().empty()) << worker.priorityError();
+}
+
+TEST(IdleWorker, InlineRunsEachJobInPost) {
+  IdleWorker worker("test", false, 1, true);
+  int n = 0;
+  worker.post([&] { ++n; });
+  worker.post([&] { ++n; });
+  EXPECT_EQ(n, 2);
+  EXPECT_EQ(worker.backlog(), 0u);
 }

@@ -1,83 +1,60 @@
 #include "mapper/loop_closer.hpp"
 
-#include <chrono>
-#include <unordered_set>
+#include <memory>
 
+#include "dlslot/cpu_clock.hpp"
 #include "dlslot/voxel_key.hpp"
 
 namespace dlslot::mapper {
 
 PointCloud voxelDownsample(const PointCloud& points, double voxel_m) {
-  std::unordered_set<uint64_t> seen;
-  seen.reserve(points.cols());
+  // An open-addressing set of the voxel keys seen (linear probing, at most half full): a keyframe's
+  // ~100 k points cost one probe each, where std::unordered_set allocated a node per voxel.
+  size_t capacity = 16;
+  while (capacity < 2 * static_cast<size_t>(points.cols())) capacity <<= 1;
+  constexpr uint64_t kEmpty = ~uint64_t{0};  // voxelKey uses 63 bits: never this
+  std::vector<uint64_t> table(capacity, kEmpty);
+  const uint64_t mask = capacity - 1;
   std::vector<Eigen::Index> keep;
-  uint64_t previous = ~uint64_t{0};  // consecutive points of a ring often share a cell: one look-up for the run
+  uint64_t previous = kEmpty;  // consecutive points of a ring often share a cell: one look-up for the run
   for (Eigen::Index i = 0; i < points.cols(); ++i) {
     const uint64_t key = voxelKey(points.col(i).head<3>().cast<double>(), voxel_m);
-    if (key != previous && seen.insert(key).second) keep.push_back(i);
+    if (key == previous) continue;
     previous = key;
+    for (uint64_t h = (key * 0x9E3779B97F4A7C15ull) >> 20 & mask;; h = (h + 1) & mask) {
+      if (table[h] == key) break;
+      if (table[h] == kEmpty) {
+        table[h] = key;
+        keep.push_back(i);
+        break;
+      }
+    }
   }
   PointCloud out(4, static_cast<Eigen::Index>(keep.size()));
   for (size_t k = 0; k < keep.size(); ++k) out.col(static_cast<Eigen::Index>(k)) = points.col(keep[k]);
   return out;
 }
 
-LoopCloser::LoopCloser(const LoopConfig& config, bool threaded) : config_(config), threaded_(threaded) {
+LoopCloser::LoopCloser(const LoopConfig& config, bool threaded, size_t capacity, bool idle_priority)
+    : config_(config), worker_("loop closure", threaded, capacity, idle_priority) {
   sc_params_.rings = config.rings;
   sc_params_.sectors = config.sectors;
   sc_params_.max_radius_m = config.max_radius_m;
-  if (threaded_) worker_ = std::thread([this] { work(); });
 }
 
-LoopCloser::~LoopCloser() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stop_ = true;
-  }
-  wake_.notify_all();
-  if (worker_.joinable()) worker_.join();
-}
+LoopCloser::~LoopCloser() = default;
 
 void LoopCloser::add(KeyframeInput kf) {
-  if (!threaded_) {
-    process(std::move(kf));
-    return;
-  }
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    queue_.push_back(std::move(kf));
-  }
-  wake_.notify_one();
+  // std::function needs a copyable job: the keyframe's points travel in a shared pointer.
+  auto shared = std::make_shared<KeyframeInput>(std::move(kf));
+  worker_.post([this, shared] { process(std::move(*shared)); });
 }
 
-void LoopCloser::drain() {
-  if (!threaded_) return;
-  std::unique_lock<std::mutex> lock(mutex_);
-  idle_.wait(lock, [this] { return queue_.empty() && !busy_; });
-}
-
-void LoopCloser::work() {
-  for (;;) {
-    KeyframeInput kf;
-    {
-      std::unique_lock<std::mutex> lock(mutex_);
-      wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
-      if (queue_.empty()) return;  // stopping
-      kf = std::move(queue_.front());
-      queue_.pop_front();
-      busy_ = true;
-    }
-    process(std::move(kf));
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      busy_ = false;
-    }
-    idle_.notify_all();
-  }
-}
+void LoopCloser::drain() { worker_.drain(); }
 
 void LoopCloser::process(KeyframeInput in) {
-  const auto start = std::chrono::steady_clock::now();
+  // CPU time of this thread: at idle priority the wall time mostly counts waiting for a core.
+  const double start = threadCpuMs();
   Keyframe kf;
   kf.frame = in.frame;
   kf.odometry = in.odometry;
@@ -189,7 +166,7 @@ void LoopCloser::process(KeyframeInput in) {
     keyframes_[id].cloud.resize(4, 0);
     keyframes_[id].descriptor = ScanContext();
   }
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double ms = threadCpuMs() - start;
   std::lock_guard<std::mutex> lock(mutex_);
   times_ms_.push_back(ms);
   if (event) {

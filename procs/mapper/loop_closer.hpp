@@ -6,14 +6,12 @@
 // becomes a loop edge and the graph is re-optimized.
 #pragma once
 
-#include <condition_variable>
-#include <deque>
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
+#include "mapper/idle_worker.hpp"
 #include "mapper/loop_verifier.hpp"
 #include "mapper/mapper_config.hpp"
 #include "mapper/pose_graph.hpp"
@@ -38,15 +36,19 @@ struct LoopEvent {
 
 class LoopCloser {
  public:
-  // threaded: verification on a worker thread (live); else inline in add() (offline, reproducible).
-  LoopCloser(const LoopConfig& config, bool threaded);
+  // threaded: verification on a worker thread (live; idle_priority: at SCHED_IDLE, idle_worker.hpp)
+  // with at most `capacity` keyframes waiting (add() blocks beyond); else inline in add()
+  // (offline, reproducible).
+  LoopCloser(const LoopConfig& config, bool threaded, size_t capacity = 64, bool idle_priority = false);
   ~LoopCloser();
   LoopCloser(const LoopCloser&) = delete;
   LoopCloser& operator=(const LoopCloser&) = delete;
 
   void add(KeyframeInput keyframe);
-  // Waits until every keyframe added so far is handled.
+  // Waits until every keyframe added so far is handled (at normal priority).
   void drain();
+  const IdleWorker& worker() const { return worker_; }
+  IdleWorker& worker() { return worker_; }
 
   // The optimized poses T_map_keyframe of keyframes 0..n-1, when they changed since the last call.
   std::optional<std::vector<Pose>> takeOptimizedPoses();
@@ -56,11 +58,10 @@ class LoopCloser {
   std::vector<LoopEvent> allEvents() const;
   int accepted() const;
   int rejected() const;
-  // Milliseconds per keyframe spent here (descriptor, search, verification, optimization).
+  // CPU milliseconds per keyframe spent here (descriptor, search, verification, optimization).
   std::vector<double> timesMs() const;
 
  private:
-  void work();
   void process(KeyframeInput kf);
 
   struct Keyframe {
@@ -73,20 +74,16 @@ class LoopCloser {
   };
   LoopConfig config_;
   ScanContextParams sc_params_;
-  bool threaded_;
   // Owned by the worker.
   std::vector<Keyframe> keyframes_;
   PoseGraph graph_;
   int quiet_until_ = -1;  // no search before this keyframe (just after an accepted loop)
 
   mutable std::mutex mutex_;
-  std::condition_variable wake_, idle_;
-  std::deque<KeyframeInput> queue_;
-  bool busy_ = false, stop_ = false;
   std::optional<std::vector<Pose>> optimized_;
   std::vector<LoopEvent> new_events_, events_;
   std::vector<double> times_ms_;
-  std::thread worker_;
+  IdleWorker worker_;  // last: its thread stops before the state above goes
 };
 
 // One point per voxel (the first), for registration clouds.

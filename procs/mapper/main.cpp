@@ -2,6 +2,7 @@
 // and the loop-closed trajectory; MAP_STATE every scan, the map files on exit. Live over LCM, or
 // offline from a recorded run (--offline RUN.lcmlog --out DIR).
 #include <lcm/lcm-cpp.hpp>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <cstring>
@@ -55,19 +56,23 @@ int acceptScan(const uint8_t* data, size_t size, FrameOrder& order, ProcessStatu
   return frame;
 }
 
-// Hands a joined frame to the mapper, decoding (and checking) its scan only when it is a keyframe.
-// A keyframe whose points do not decode is refused and the frame skipped, as a missing scan would be.
-bool feed(Mapper& mapper, Joiner::Joined& j, ProcessStatus& status, const std::string& channel) {
-  if (mapper.needsScan(j.b->pose)) {
+// Hands a joined frame to the mapper with its scan raw: the points are decoded (and checked)
+// only if the scan becomes a keyframe, and then on the mapper's keyframe thread. A keyframe whose
+// points do not decode is refused (Mapper::takeRefusedScans) and no keyframe is made of it.
+void feed(Mapper& mapper, Joiner::Joined& j) {
+  auto bytes = std::make_shared<std::vector<uint8_t>>(std::move(j.a->bytes));
+  j.b->load_scan = [bytes]() {
     point_cloud_t m;
-    if (const Refusal why = decodeChecked(j.a->bytes.data(), j.a->bytes.size(), &m)) {
-      status.refused(channel, why, "frame " + std::to_string(j.frame) + ": ");
-      return false;
-    }
-    j.b->scan = fromMsg(m);
-  }
-  mapper.add(*j.b);
-  return true;
+    if (const Refusal why = decodeChecked(bytes->data(), bytes->size(), &m)) throw ScanRefused(why.reason, why.detail);
+    return fromMsg(m);
+  };
+  mapper.add(std::move(*j.b));
+}
+
+// What the keyframe threads refused or caught since the last call, into the process status.
+void reportWorkers(Mapper& mapper, ProcessStatus& status, const std::string& channel) {
+  for (const ScanRefused& r : mapper.takeRefusedScans()) status.refused(channel, Refusal{r.reason, r.what()}, "keyframe: ");
+  for (const std::string& e : mapper.takeErrors()) status.error(e);
 }
 
 double nowSeconds() {
@@ -81,8 +86,10 @@ void printSummary(const Mapper& mapper, const std::string& out, const std::vecto
   std::printf("mapper: %zu keyframes, map %zu voxels (%.2f m), removed %zu voxels; loops: %d accepted, %d refused\n",
               mapper.keyframes().size(), mapper.map().size(), mapper.map().voxelSize(), mapper.removed().size(),
               mapper.loops().accepted(), mapper.loops().rejected());
-  std::printf("  per keyframe: removal + map %.2f ms mean; loop thread (descriptor, search, verification, graph) %.2f ms "
-              "mean, %.2f p95, %.1f max\n",
+  std::printf("  keyframe thread: %d scans deferred (it was %zu keyframes behind at most, bound %d)\n",
+              mapper.keyframesDeferred(), mapper.maxBacklog(), mapper.config().max_backlog_keyframes);
+  std::printf("  per keyframe, CPU: decoding + removal + map %.2f ms mean; loop thread (descriptor, search, verification, "
+              "graph) %.2f ms mean, %.2f p95, %.1f max\n",
               mapper.keyframes().empty() ? 0.0 : mapper.keyframeMs() / mapper.keyframes().size(), loop.mean(),
               loop.percentile(95), loop.max());
   for (const LoopEvent& e : mapper.loops().allEvents())
@@ -110,10 +117,12 @@ int runOffline(const MapperConfig& config, const Channels& channels, const std::
   int frames = 0, missing = 0;
   auto handle = [&](std::vector<Joiner::Joined> ready) {
     for (Joiner::Joined& j : ready) {
-      if (!j.a || !j.b || !feed(mapper, j, guard, channels.scan)) {
+      if (!j.a || !j.b) {
         ++missing;
         continue;
       }
+      feed(mapper, j);
+      reportWorkers(mapper, guard, channels.scan);
       ++frames;
     }
   };
@@ -143,6 +152,7 @@ int runOffline(const MapperConfig& config, const Channels& channels, const std::
   }
   handle(joiner.flush());
   mapper.finish();
+  reportWorkers(mapper, guard, channels.scan);
   progress.finish(std::to_string(frames) + " scans");
   std::printf("mapper: %d scans with their SLOT_STATE, %d with one of the two missing\n", frames, missing);
   for (const auto& [what, n] : guard.refusals()) std::printf("  refused %s: %lld\n", what.c_str(), static_cast<long long>(n));
@@ -154,6 +164,7 @@ int runOffline(const MapperConfig& config, const Channels& channels, const std::
 int runLive(const MapperConfig& config, const Channels& channels, const NodeOptions& opts, const std::string& out) {
   Node node("mapper", opts.lcm_url, channels);
   Mapper mapper(config, /*threaded=*/true);
+  for (const std::string& e : mapper.priorityErrors()) node.status().warn(e + " (it runs at normal priority)");
   Joiner joiner(config.join_timeout_s);
   auto handleReady = [&] {
     for (Joiner::Joined& j : joiner.release(nowSeconds())) {
@@ -164,11 +175,15 @@ int runLive(const MapperConfig& config, const Channels& channels, const NodeOpti
       try {
         const Pose slot_pose = j.b->pose;
         const int64_t utime = j.b->utime;
-        if (!feed(mapper, j, node.status(), channels.scan)) continue;
+        feed(mapper, j);
+        reportWorkers(mapper, node.status(), channels.scan);
         node.publish(config.channel, mapStateMsg(mapper, j.frame, utime, slot_pose, mapper.loops().takeEvents()));
         node.status().frameDone(j.frame, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-        node.status().set("keyframes", static_cast<int64_t>(mapper.keyframes().size()));
-        node.status().set("map_voxels", static_cast<int64_t>(mapper.map().size()));
+        const MapperSnapshot now = mapper.snapshot();
+        node.status().set("keyframes", now.keyframes);
+        node.status().set("map_voxels", static_cast<int64_t>(now.map_voxels));
+        node.status().set("keyframes_waiting", static_cast<int64_t>(now.backlog));
+        node.status().set("keyframes_deferred", now.keyframes_deferred);
         node.status().set("loops_accepted", mapper.loops().accepted());
         node.status().set("loops_refused", mapper.loops().rejected());
       } catch (const std::exception& e) {
@@ -195,10 +210,25 @@ int runLive(const MapperConfig& config, const Channels& channels, const NodeOpti
   });
   node.every(0.05, handleReady);
   const int code = node.run();
+  // Where the process's CPU went while the pipeline ran: the threads at normal priority (LCM's
+  // receiving, joining, MAP_STATE: what competes with the pipeline) and the idle-priority ones.
+  {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    const double total_ms = 1e3 * (usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                            1e-3 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+    const double idle_ms = mapper.workerCpuMs();
+    const double frames = std::max<double>(1, static_cast<double>(node.status().framesHandled()));
+    std::printf("mapper: CPU while the pipeline ran: %.2f ms a frame at normal priority (receiving, joining, MAP_STATE; "
+                "start-up included), %.2f ms a frame at idle priority (keyframes, loop closure), %zu keyframes waiting "
+                "at the end\n",
+                (total_ms - idle_ms) / frames, idle_ms / frames, mapper.snapshot().backlog);
+  }
   // Stopped (SIGINT/SIGTERM): what is still waiting goes in, then the files.
   for (Joiner::Joined& j : joiner.flush())
-    if (j.a && j.b) feed(mapper, j, node.status(), channels.scan);
+    if (j.a && j.b) feed(mapper, j);
   mapper.finish();
+  reportWorkers(mapper, node.status(), channels.scan);
   const std::vector<std::string> files = out.empty() ? std::vector<std::string>{} : writeMapOutputs(out, mapper);
   printSummary(mapper, out, files);
   return code;

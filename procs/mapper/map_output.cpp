@@ -74,9 +74,13 @@ MapImageStats writeMapImage(const std::string& path, const Mapper& mapper, int m
   for (Eigen::Index i = 0; i < pts.cols(); ++i) z[static_cast<size_t>(i)] = pts(2, i);
   float zlo = 0, zhi = 1;
   if (!z.empty()) {
-    std::sort(z.begin(), z.end());
-    zlo = z[z.size() * 2 / 100];
-    zhi = std::max(zlo + 0.1f, z[z.size() * 98 / 100]);
+    // Two selections, not a sort of a million heights.
+    const auto lo_it = z.begin() + static_cast<std::ptrdiff_t>(z.size() * 2 / 100);
+    const auto hi_it = z.begin() + static_cast<std::ptrdiff_t>(z.size() * 98 / 100);
+    std::nth_element(z.begin(), lo_it, z.end());
+    zlo = *lo_it;
+    std::nth_element(lo_it, hi_it, z.end());
+    zhi = std::max(zlo + 0.1f, *hi_it);
   }
   cv::Mat top(s.height, s.width, CV_32F, cv::Scalar(-1e9));
   for (Eigen::Index i = 0; i < pts.cols(); ++i) {

@@ -1,7 +1,10 @@
 #include "mapper/mapper.hpp"
 
-#include <chrono>
 #include <cmath>
+#include <memory>
+
+#include "dlslot/cpu_clock.hpp"
+#include "mapper/box_cutter.hpp"
 
 namespace dlslot::mapper {
 
@@ -10,7 +13,20 @@ Mapper::Mapper(const MapperConfig& config, bool threaded)
       boxes_(config.box_margin_m, config.follow_frames, config.remove_movable, config.ground_clearance_m),
       map_(config.map_voxel_m),
       removed_(config.map_voxel_m),
-      loops_(std::make_unique<LoopCloser>(config.loop, threaded)) {}
+      loops_(std::make_unique<LoopCloser>(config.loop, threaded, static_cast<size_t>(config.max_backlog_keyframes),
+                                          config.idle_priority)),
+      // Every keyframe admitted while the backlog was below the bound must fit without blocking the
+      // caller: those still in their decision delay (one per scan at most) come on top of the bound.
+      committer_(std::make_unique<IdleWorker>(
+          "keyframes", threaded,
+          static_cast<size_t>(config.max_backlog_keyframes) + static_cast<size_t>(config.decision_delay_frames) + 2,
+          config.idle_priority)) {}
+
+Mapper::~Mapper() {
+  // The keyframe thread uses the loop closer: it stops first.
+  committer_.reset();
+  loops_.reset();
+}
 
 bool Mapper::needsScan(const Pose& pose) const {
   if (!last_keyframe_pose_) return true;
@@ -19,83 +35,135 @@ bool Mapper::needsScan(const Pose& pose) const {
          Eigen::AngleAxisd(d.rotation()).angle() * 180.0 / M_PI >= config_.keyframe_angle_deg;
 }
 
-void Mapper::add(const MapperInput& in) {
+void Mapper::add(MapperInput in) {
   frames_[in.frame] = {in.utime, in.pose};
   boxes_.add(in.frame, in.utime * 1e-6, in.tracks);
   if (needsScan(in.pose)) {
-    last_keyframe_pose_ = in.pose;
-    Pending p{in.frame, in.utime, in.pose, PointCloud(4, in.scan.cols())};
-    Eigen::Index n = 0;
-    const double lo = config_.min_range_m * config_.min_range_m, hi = config_.max_range_m * config_.max_range_m;
-    for (Eigen::Index i = 0; i < in.scan.cols(); ++i) {
-      const double r2 = in.scan.col(i).head<3>().cast<double>().squaredNorm();
-      if (r2 >= lo && r2 <= hi) p.scan.col(n++) = in.scan.col(i);
+    if (committer_->backlog() >= static_cast<size_t>(config_.max_backlog_keyframes)) {
+      // The keyframe thread is behind (no idle time on the machine): this scan is not taken; the
+      // next one is considered again, so keyframes grow further apart instead of the queue.
+      ++deferred_;
+    } else {
+      last_keyframe_pose_ = in.pose;
+      pending_.push_back({in.frame, in.utime, in.pose, std::move(in.scan), std::move(in.load_scan)});
     }
-    p.scan.conservativeResize(4, n);
-    pending_.push_back(std::move(p));
   }
   while (!pending_.empty() && pending_.front().frame <= in.frame - config_.decision_delay_frames) {
-    commit(pending_.front());
+    auto job = std::make_shared<Pending>(std::move(pending_.front()));
     pending_.pop_front();
+    // The removal boxes are decided here (the tracks' history lives on this thread); the points are
+    // handled on the keyframe thread.
+    auto boxes = std::make_shared<std::vector<Box>>(boxes_.removalBoxes(job->frame, job->utime * 1e-6));
+    committer_->post([this, job, boxes] { commit(*job, *boxes); });
   }
   boxes_.forgetBefore(pending_.empty() ? in.frame - config_.decision_delay_frames : pending_.front().frame);
-  applyLoopResult();
 }
 
 void Mapper::finish() {
   while (!pending_.empty()) {
-    commit(pending_.front());
+    auto job = std::make_shared<Pending>(std::move(pending_.front()));
     pending_.pop_front();
+    auto boxes = std::make_shared<std::vector<Box>>(boxes_.removalBoxes(job->frame, job->utime * 1e-6));
+    committer_->post([this, job, boxes] { commit(*job, *boxes); });
   }
+  committer_->drain();
   loops_->drain();
   applyLoopResult();
 }
 
-void Mapper::commit(Pending& p) {
-  const auto start = std::chrono::steady_clock::now();
-  const Pose lidar_from_world = p.pose.inverse();
-  // The removal boxes in the lidar frame, with their heading's sine and cosine and the radius of
-  // their footprint worked out once: the test runs for every point of the keyframe against every
-  // box (Box::contains's test, in float, after a cheap footprint-circle rejection).
-  struct Cut {
-    Eigen::Vector3f center, half;
-    float c, s, reach2;
-  };
-  std::vector<Cut> cuts;
-  for (const Box& world_box : boxes_.removalBoxes(p.frame, p.utime * 1e-6)) {
-    const Box b = world_box.transformed(lidar_from_world);
-    const float reach = 0.5f * static_cast<float>(b.size.head<2>().norm());
-    cuts.push_back({b.center.cast<float>(), 0.5f * b.size.cast<float>(), static_cast<float>(std::cos(b.yaw)),
-                    static_cast<float>(std::sin(b.yaw)), reach * reach});
+MapperSnapshot Mapper::snapshot() const {
+  MapperSnapshot s;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    s.map_from_world = map_from_world_;
   }
-  PointCloud kept(4, p.scan.cols()), gone(4, p.scan.cols());
-  Eigen::Index nk = 0, ng = 0;
-  for (Eigen::Index i = 0; i < p.scan.cols(); ++i) {
-    bool inside = false;
-    for (const Cut& k : cuts) {
-      const Eigen::Vector3f d = p.scan.col(i).head<3>() - k.center;
-      if (d.head<2>().squaredNorm() > k.reach2) continue;
-      inside = std::abs(k.c * d.x() + k.s * d.y()) <= k.half.x() && std::abs(-k.s * d.x() + k.c * d.y()) <= k.half.y() &&
-               std::abs(d.z()) <= k.half.z();
-      if (inside) break;
+  s.keyframes = keyframe_count_;
+  s.map_voxels = map_voxels_;
+  s.removed_voxels = removed_voxels_;
+  s.keyframes_deferred = deferred_;
+  s.backlog = committer_->backlog();
+  return s;
+}
+
+Pose Mapper::mapFromWorld() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return map_from_world_;
+}
+
+std::vector<ScanRefused> Mapper::takeRefusedScans() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<ScanRefused> out;
+  out.swap(refused_);
+  return out;
+}
+
+std::vector<std::string> Mapper::priorityErrors() const {
+  std::vector<std::string> out;
+  for (const IdleWorker* w : {committer_.get(), &loops_->worker()})
+    if (!w->priorityError().empty()) out.push_back(w->priorityError());
+  return out;
+}
+
+std::vector<std::string> Mapper::takeErrors() {
+  std::vector<std::string> out = committer_->takeErrors();
+  for (std::string& e : loops_->worker().takeErrors()) out.push_back(std::move(e));
+  return out;
+}
+
+void Mapper::commit(Pending& p, const std::vector<Box>& world_boxes) {
+  // CPU time of this thread: at idle priority the wall time mostly counts waiting for a core.
+  const double start = threadCpuMs();
+  PointCloud scan;
+  if (p.load_scan) {
+    try {
+      scan = p.load_scan();
+    } catch (const ScanRefused& e) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      refused_.push_back(e);
+      return;
     }
-    (inside ? gone.col(ng++) : kept.col(nk++)) = p.scan.col(i);
+    p.load_scan = nullptr;  // frees the raw message
+  } else {
+    scan.swap(p.scan);
   }
+  // Crop to [min_range, max_range] in place.
+  Eigen::Index n = 0;
+  const float lo = static_cast<float>(config_.min_range_m * config_.min_range_m),
+              hi = static_cast<float>(config_.max_range_m * config_.max_range_m);
+  for (Eigen::Index i = 0; i < scan.cols(); ++i) {
+    const float r2 = scan.col(i).head<3>().squaredNorm();
+    if (r2 >= lo && r2 <= hi) {
+      if (n != i) scan.col(n) = scan.col(i);
+      ++n;
+    }
+  }
+  // The removal boxes in the lidar frame (box_cutter.hpp).
+  const Pose lidar_from_world = p.pose.inverse();
+  std::vector<Box> boxes;
+  boxes.reserve(world_boxes.size());
+  for (const Box& b : world_boxes) boxes.push_back(b.transformed(lidar_from_world));
+  const BoxCutter cutter(boxes, config_.max_range_m);
+  PointCloud kept(4, n), gone(4, n);
+  Eigen::Index nk = 0, ng = 0;
+  for (Eigen::Index i = 0; i < n; ++i) (cutter.inside(scan.col(i).head<3>()) ? gone.col(ng++) : kept.col(nk++)) = scan.col(i);
   kept.conservativeResize(4, nk);
   gone.conservativeResize(4, ng);
   const int id = static_cast<int>(keyframes_.size());
-  const Pose T_map = map_from_world_ * p.pose;
+  const Pose T_map = mapFromWorld() * p.pose;
   const size_t fresh = map_.insert(id, T_map, kept);
   removed_.insert(id, T_map, gone);
   keyframes_.push_back({p.frame, p.utime, p.pose, T_map, static_cast<int>(nk), static_cast<int>(ng)});
-  keyframe_ms_ += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  keyframe_count_ = static_cast<int>(keyframes_.size());
+  map_voxels_ = map_.size();
+  removed_voxels_ = removed_.size();
+  keyframe_ms_ += threadCpuMs() - start;
   // Only a keyframe that saw something new keeps its registration cloud for later loops: one
   // that adds (almost) no voxel to the map is a place already held by earlier keyframes, so the
   // loop closer's memory, like the map's, stops growing when the map does (driving in circles,
   // standing in traffic).
   const bool keep_cloud = static_cast<double>(fresh) >= config_.min_new_fraction * static_cast<double>(std::max<Eigen::Index>(nk, 1));
   loops_->add({id, p.frame, p.pose, std::move(kept), keep_cloud});
-  p.scan.resize(4, 0);
+  applyLoopResult();
 }
 
 void Mapper::applyLoopResult() {
@@ -103,14 +171,20 @@ void Mapper::applyLoopResult() {
   if (!poses || poses->empty()) return;
   optimized_ = std::move(*poses);
   const int last = static_cast<int>(optimized_.size()) - 1;
-  map_from_world_ = optimized_[last] * keyframes_.at(last).odometry.inverse();
+  const Pose correction = optimized_[last] * keyframes_.at(last).odometry.inverse();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    map_from_world_ = correction;
+  }
   // Keyframes the loop closer has not seen yet follow the newest correction.
   std::vector<Pose> all(keyframes_.size());
   for (size_t k = 0; k < keyframes_.size(); ++k)
-    all[k] = k < optimized_.size() ? optimized_[k] : map_from_world_ * keyframes_[k].odometry;
+    all[k] = k < optimized_.size() ? optimized_[k] : correction * keyframes_[k].odometry;
   for (size_t k = 0; k < keyframes_.size(); ++k) keyframes_[k].map = all[k];
   map_.repose(all);
   removed_.repose(all);
+  map_voxels_ = map_.size();
+  removed_voxels_ = removed_.size();
 }
 
 std::vector<std::pair<int, Pose>> Mapper::mapTrajectory() const {
@@ -118,7 +192,7 @@ std::vector<std::pair<int, Pose>> Mapper::mapTrajectory() const {
   size_t k = 0;  // the newest keyframe at or before the frame
   for (const auto& [frame, tp] : frames_) {
     while (k + 1 < keyframes_.size() && keyframes_[k + 1].frame <= frame) ++k;
-    Pose correction = map_from_world_;
+    Pose correction = mapFromWorld();
     if (!keyframes_.empty() && keyframes_[k].frame <= frame) correction = keyframes_[k].map * keyframes_[k].odometry.inverse();
     out.emplace_back(frame, correction * tp.second);
   }

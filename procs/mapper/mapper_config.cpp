@@ -29,6 +29,11 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
   s.get("decision_delay_frames", c.decision_delay_frames);
   s.get("follow_frames", c.follow_frames);
   s.get("join_timeout_s", c.join_timeout_s);
+  s.get("max_backlog_keyframes", c.max_backlog_keyframes);
+  s.get("idle_priority", c.idle_priority);
+  if (c.max_backlog_keyframes < 1)
+    throw ConfigError(s.file() + ": " + s.path() + ".max_backlog_keyframes: expected >= 1, got " +
+                      std::to_string(c.max_backlog_keyframes));
   for (const auto& [k, v] : {std::pair<const char*, double>{"keyframe_distance_m", c.keyframe_distance_m},
                              {"keyframe_angle_deg", c.keyframe_angle_deg},
                              {"max_range_m", c.max_range_m},

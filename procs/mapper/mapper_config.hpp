@@ -35,6 +35,8 @@ struct MapperConfig {
   double min_new_fraction = 0.01;  // a keyframe keeps its loop-closure cloud when this share of its points made new voxels
   int decision_delay_frames = 15, follow_frames = 15;
   double join_timeout_s = 5.0;  // live: how long a scan waits for its SLOT_STATE (and back)
+  int max_backlog_keyframes = 50;  // live: keyframes that may wait for the keyframe thread (and for loop closure)
+  bool idle_priority = true;       // live: the keyframe and loop-closure threads at SCHED_IDLE
   LoopConfig loop;
 
   // Reads and checks the section; throws ConfigError naming the key and what was expected.

@@ -44,11 +44,12 @@ map_state_t mapStateMsg(const Mapper& mapper, int frame, int64_t utime, const Po
   map_state_t m;
   m.utime = utime;
   m.frame = frame;
-  m.map_from_world = dlslot::toMsg(mapper.mapFromWorld());
-  m.map_pose = dlslot::toMsg(mapper.mapFromWorld() * slot_pose);
-  m.keyframes = static_cast<int32_t>(mapper.keyframes().size());
-  m.map_points = static_cast<int32_t>(mapper.map().size());
-  m.removed_points = static_cast<int32_t>(mapper.removed().size());
+  const MapperSnapshot now = mapper.snapshot();
+  m.map_from_world = dlslot::toMsg(now.map_from_world);
+  m.map_pose = dlslot::toMsg(now.map_from_world * slot_pose);
+  m.keyframes = static_cast<int32_t>(now.keyframes);
+  m.map_points = static_cast<int32_t>(now.map_voxels);
+  m.removed_points = static_cast<int32_t>(now.removed_voxels);
   m.loops_accepted = mapper.loops().accepted();
   m.loops_rejected = mapper.loops().rejected();
   for (const LoopEvent& e : new_events) m.loops.push_back(toMsg(e));

@@ -1,5 +1,6 @@
 // Counts what a Foxglove WebSocket client receives per topic without decoding it (a viewer on
-// another machine), to measure the live bridge's cost to the pipeline:
+// another machine), to measure the live bridge's cost to the pipeline; prints the counts, the bytes
+// and its own CPU time (ms):
 //   NODE_PATH=build/npm/node_modules node tests/js/ws_count.cjs ws://127.0.0.1:PORT /lidar/points,/slot/tracks SECONDS
 "use strict";
 const WebSocket = require("ws");
@@ -7,7 +8,11 @@ const [url, topicList, seconds] = process.argv.slice(2);
 const wanted = topicList.split(",");
 const counts = {}; const bytes = {};
 const sub = new Map();
-function done() { console.log(JSON.stringify({ counts, bytes })); process.exit(0); }
+function done() {
+  const cpu = process.cpuUsage();
+  console.log(JSON.stringify({ counts, bytes, cpu_ms: Math.round((cpu.user + cpu.system) / 1000) }));
+  process.exit(0);
+}
 setTimeout(done, Number(seconds) * 1000);
 function connect() {
   const ws = new WebSocket(url, ["foxglove.websocket.v1"]);

@@ -15,7 +15,7 @@ namespace dlslot::foxglove {
 struct QueuedMessage {
   uint32_t subscription;                       // the client's subscription id for the channel
   uint64_t time_ns;                            // receive time, nanoseconds since the epoch
-  std::shared_ptr<const std::string> payload;  // shared by every client that gets it
+  std::shared_ptr<std::string> payload;        // shared by every client that gets it; never changed while shared
 };
 
 class ClientQueue {

@@ -7,6 +7,8 @@
 #include <cstring>
 #include <set>
 
+#include "ros1_point_cloud.hpp"
+
 namespace dlslot::foxglove {
 namespace {
 
@@ -75,7 +77,8 @@ void idColour(int id, float rgba[4]) {
 
 Converter::Converter(const Channels& channels, ConverterOptions options) : channels_(channels), opt_(options) {
   topics_ = {
-      {"/lidar/points", &pointCloudSchema(), channels_.scan},
+      {"/lidar/points", opt_.scan_encoding == ScanEncoding::kRos1 ? &pointCloud2Schema() : &pointCloudSchema(),
+       channels_.scan},
       {"/detections", &sceneUpdateSchema(), channels_.detections},
       {"/ground_truth/boxes", &sceneUpdateSchema(), channels_.ground_truth},
       {"/ground_truth/path", &posesInFrameSchema(), channels_.ground_truth},
@@ -94,7 +97,7 @@ Refusal Converter::convert(const std::string& channel, const void* data, size_t 
     add(msg, out);
     return {};
   };
-  if (channel == channels_.scan) return as(point_cloud_t());
+  if (channel == channels_.scan) return addScan(data, size, out);
   if (channel == channels_.detections) return as(detections_t());
   if (channel == channels_.ground_truth) return as(ground_truth_t());
   if (channel == channels_.odometry) return as(odometry_t());
@@ -105,8 +108,35 @@ Refusal Converter::convert(const std::string& channel, const void* data, size_t 
   return {};
 }
 
+Refusal Converter::addScan(const void* data, size_t size, std::vector<Output>& out, int* frame) {
+  if (opt_.scan_encoding == ScanEncoding::kJson) {
+    point_cloud_t m;
+    if (Refusal r = decodeChecked(data, size, &m)) return r;
+    if (frame) *frame = m.frame;
+    add(m, out);
+    return {};
+  }
+  ros1::ScanId id;
+  if (!wanted(kScan)) {
+    const Refusal r = ros1::checkScanHeader(data, size, &id);
+    if (!r && frame) *frame = id.frame;
+    return r;
+  }
+  Output o{kScan, {}, -1};
+  if (Refusal r = ros1::writePointCloud2FromLcm(data, size, kLidarFrame, o.bytes, &id)) return r;
+  if (frame) *frame = id.frame;
+  o.utime = id.utime;
+  out.push_back(std::move(o));
+  return {};
+}
+
 void Converter::add(const point_cloud_t& m, std::vector<Output>& out) {
   if (!wanted(kScan)) return;
+  if (opt_.scan_encoding == ScanEncoding::kRos1) {
+    out.push_back({kScan, {}, m.utime});
+    ros1::writePointCloud2(m, kLidarFrame, out.back().bytes);
+    return;
+  }
   // Interleaved little-endian float32 x y z intensity, 16 bytes a point (x86 is little-endian,
   // as Foxglove's packed fields are).
   static_assert(sizeof(float) == 4, "float32");

@@ -1,9 +1,10 @@
-// DL-SLOT's LCM messages as Foxglove messages (JSON encoding), one place for the exporter
-// (dlslot-export --mcap) and the live bridge (dlslot-foxglove).
+// DL-SLOT's LCM messages as Foxglove messages (JSON encoding; the scan optionally as ROS 1
+// PointCloud2, ros1_point_cloud.hpp), one place for the exporter (dlslot-export --mcap) and the
+// live bridge (dlslot-foxglove).
 //
 // Each channel becomes one or more topics, each getting exactly one message per LCM message,
 // so every topic's message count equals its channel's count in the log:
-//   LIDAR_SCAN     -> /lidar/points          foxglove.PointCloud    (frame lidar)
+//   LIDAR_SCAN     -> /lidar/points          foxglove.PointCloud    (frame lidar; or sensor_msgs/PointCloud2)
 //   DETECTIONS     -> /detections            foxglove.SceneUpdate   (lidar; cube + class/score text, coloured by class)
 //   GROUND_TRUTH   -> /ground_truth/boxes    foxglove.SceneUpdate   (lidar; coloured by id)
 //                     /ground_truth/path     foxglove.PosesInFrame  (world; the poses so far)
@@ -50,15 +51,22 @@ struct Topic {
   std::string channel;       // the LCM channel it comes from
 };
 
-// One Foxglove message: the topic (index into Converter::topics()), its JSON text and the
-// timestamp of the scan it belongs to (microseconds; -1 for messages of no scan: status, raw).
+// One Foxglove message: the topic (index into Converter::topics()), its bytes in the topic's
+// schema's message encoding (JSON text, or ROS 1 serialized) and the timestamp of the scan it
+// belongs to (microseconds; -1 for messages of no scan: status, raw).
 struct Output {
   size_t topic;
-  std::string json;
+  std::string bytes;
   int64_t utime;
 };
 
+// How /lidar/points is encoded. JSON (foxglove.PointCloud, points in base64) keeps every topic
+// of an MCAP file readable as JSON; ROS 1 PointCloud2 is a quarter smaller and costs a copy of the
+// points instead of a base64 pass, which the live bridge needs to keep pace with the pipeline.
+enum class ScanEncoding { kJson, kRos1 };
+
 struct ConverterOptions {
+  ScanEncoding scan_encoding = ScanEncoding::kJson;
   // A track's recent path drawn behind it: 3 s at KITTI's 10 Hz shows where it is heading
   // without the lines of a long run crowding the scene.
   int track_path_frames = 30;
@@ -83,6 +91,11 @@ class Converter {
   // the refusal (nothing appended) when it does not decode or is not valid; a channel of no
   // known type is passed through as dlslot.LcmMessage.
   Refusal convert(const std::string& channel, const void* data, size_t size, std::vector<Output>& out);
+  // A scan from its LCM bytes, checked as the guard checks it (refused: nothing appended). In
+  // ROS 1 encoding the points go from the LCM bytes to the PointCloud2 in one pass (no decoded
+  // message in between), and a scan no one wants is only checked up to its points. `frame` (when
+  // given) gets the scan's frame.
+  Refusal addScan(const void* data, size_t size, std::vector<Output>& out, int* frame = nullptr);
   // The typed entry points (the bridge's typed subscriptions call these).
   void add(const point_cloud_t& m, std::vector<Output>& out);
   void add(const detections_t& m, std::vector<Output>& out);

@@ -1,5 +1,7 @@
 #include "foxglove_schemas.hpp"
 
+#include "ros1_point_cloud.hpp"
+
 namespace dlslot::foxglove {
 namespace {
 
@@ -34,6 +36,11 @@ const SchemaText& pointCloudSchema() {
                  R"(,"point_stride":{"type":"integer","minimum":0},"fields":)" +
                  array(R"({"type":"object","title":"foxglove.PackedElementField","properties":{"name":{"type":"string"},"offset":{"type":"integer","minimum":0},"type":{"type":"integer","description":"foxglove.NumericType: 1 UINT8 2 INT8 3 UINT16 4 INT16 5 UINT32 6 INT32 7 FLOAT32 8 FLOAT64"}}})") +
                  R"(,"data":{"type":"string","contentEncoding":"base64"})")};
+  return s;
+}
+
+const SchemaText& pointCloud2Schema() {
+  static const SchemaText s{ros1::kPointCloud2, ros1::pointCloud2Definition(), "ros1msg", "ros1"};
   return s;
 }
 

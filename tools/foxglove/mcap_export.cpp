@@ -55,12 +55,12 @@ ExportStats exportMcap(const std::string& log_path, const std::string& mcap_path
       if (id == 0) {
         const Topic& t = conv.topics()[o.topic];
         uint16_t& schema = schema_ids[t.schema];
-        if (schema == 0) schema = writer.addSchema(t.schema->name, "jsonschema", t.schema->json);
-        id = writer.addChannel(schema, t.name, "json", {{"lcm_channel", t.channel}});
+        if (schema == 0) schema = writer.addSchema(t.schema->name, t.schema->schema_encoding, t.schema->text);
+        id = writer.addChannel(schema, t.name, t.schema->message_encoding, {{"lcm_channel", t.channel}});
       }
       uint64_t log_time = event_ns;
       if (o.utime >= 0) log_time = scan_time.emplace(o.utime, event_ns).first->second;
-      writer.write(id, log_time, event_ns, o.json);
+      writer.write(id, log_time, event_ns, o.bytes);
       ++stats.messages[conv.topics()[o.topic].name];
     }
     if (progress && ++since_progress >= 64) {

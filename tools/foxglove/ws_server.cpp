@@ -5,6 +5,10 @@
 #include <websocketpp/server.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <map>
 #include <mutex>
@@ -64,8 +68,9 @@ struct Server::Impl {
     JsonText adv;
     adv.beginObject().field("op", "advertise").key("channels").beginArray();
     for (const auto& c : channels)
-      adv.beginObject().field("id", int64_t{c.id}).field("topic", c.topic).field("encoding", "json")
-          .field("schemaName", c.schema_name).field("schema", c.schema).field("schemaEncoding", "jsonschema").endObject();
+      adv.beginObject().field("id", int64_t{c.id}).field("topic", c.topic).field("encoding", c.encoding)
+          .field("schemaName", c.schema_name).field("schema", c.schema).field("schemaEncoding", c.schema_encoding)
+          .endObject();
     adv.endArray().endObject();
     {
       std::lock_guard<std::mutex> lock(mu);
@@ -152,15 +157,29 @@ struct Server::Impl {
         }
       }
     }
-    std::string frame;
     for (auto& [h, m] : ready) {
-      frame.resize(13);
-      frame[0] = 0x01;  // Message Data
-      for (int i = 0; i < 4; ++i) frame[1 + i] = static_cast<char>((m.subscription >> (8 * i)) & 0xFF);
-      for (int i = 0; i < 8; ++i) frame[5 + i] = static_cast<char>((m.time_ns >> (8 * i)) & 0xFF);
-      frame.append(*m.payload);
       websocketpp::lib::error_code ec;
-      ws.send(h, frame, websocketpp::frame::opcode::binary, ec);
+      const auto con = ws.get_con_from_hdl(h, ec);
+      if (ec || !con) continue;
+      // A frame prepared here goes to the socket as it is (websocketpp copies the payload of any
+      // other message once more): header (WebSocket frame header, then Message Data's op,
+      // subscription id and receive time) and payload are two buffers of one write.
+      const auto msg = con->get_message(websocketpp::frame::opcode::binary, 0);
+      std::string& body = msg->get_raw_payload();
+      if (m.payload.use_count() == 1) body.swap(*m.payload);  // the last holder: take the bytes
+      else body = *m.payload;
+      const size_t size = 13 + body.size();
+      std::string header = websocketpp::frame::prepare_header(
+          websocketpp::frame::basic_header(websocketpp::frame::opcode::binary, size, true, false, false),
+          websocketpp::frame::extended_header(size));
+      char op[13];
+      op[0] = 0x01;  // Message Data
+      for (int i = 0; i < 4; ++i) op[1 + i] = static_cast<char>((m.subscription >> (8 * i)) & 0xFF);
+      for (int i = 0; i < 8; ++i) op[5 + i] = static_cast<char>((m.time_ns >> (8 * i)) & 0xFF);
+      header.append(op, sizeof op);
+      msg->set_header(header);
+      msg->set_prepared(true);
+      ec = con->send(msg);
       if (!ec) {
         std::lock_guard<std::mutex> lock(mu);
         ++st.sent;
@@ -212,7 +231,14 @@ Server::Server(ServerOptions options, std::vector<AdvertisedChannel> channels) :
   }
   s.timer = std::make_unique<asio::steady_timer>(s.ws.get_io_service());
   asio::post(s.ws.get_io_service(), [&s] { s.tick(); });
-  s.thread = std::thread([&s] { s.ws.run(); });
+  s.thread = std::thread([&s] {
+    // The lowest CPU priority for the sending (nice is per thread on Linux): on a full machine the
+    // pipeline's processes get the cores first and the clients are fed when they are idle, their
+    // drop-oldest queues absorbing the wait. The LCM side (receiving, checking, building each
+    // message once) keeps the process's priority, so the bridge never loses a message on its socket.
+    setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), s.opt.send_nice);
+    s.ws.run();
+  });
 }
 
 Server::~Server() {
@@ -247,17 +273,22 @@ bool Server::subscribed(uint32_t channel) const {
   return it != impl_->subscribers.end() && it->second > 0;
 }
 
-void Server::publish(uint32_t channel, uint64_t time_ns, std::shared_ptr<const std::string> payload) {
+void Server::publish(uint32_t channel, uint64_t time_ns, std::shared_ptr<std::string> payload) {
   Impl& s = *impl_;
   bool any = false;
   {
     std::lock_guard<std::mutex> lock(s.mu);
+    // The last subscriber's queue gets the caller's reference itself: once queued, the queues
+    // hold every reference, so the client that sends the message last can take its bytes over.
+    std::pair<Impl::Client*, uint32_t> last{nullptr, 0};
     for (auto& [h, c] : s.clients) {
       const auto sub = c.subscription_of_channel.find(channel);
       if (sub == c.subscription_of_channel.end()) continue;
-      c.queue.push({sub->second, time_ns, payload});
-      any = true;
+      if (last.first) last.first->queue.push({last.second, time_ns, payload});
+      last = {&c, sub->second};
     }
+    if (last.first) last.first->queue.push({last.second, time_ns, std::move(payload)});
+    any = last.first != nullptr;
   }
   if (any && !s.wake_pending.exchange(true)) asio::post(s.ws.get_io_service(), [&s] { s.pump(); });
 }

@@ -2,7 +2,9 @@
 // standalone asio, on a thread of its own: serverInfo and advertise on connect, subscribe and
 // unsubscribe from clients, binary Message Data (opcode 1, subscription id, receive time,
 // payload) to each subscriber through its own drop-oldest queue (client_queue.hpp). publish()
-// never blocks on a client: it queues and wakes the server thread.
+// never blocks on a client: it queues and wakes the server thread. A message's bytes are made
+// once for all clients and are not copied on the way to the socket when one client takes them
+// (the WebSocket and Message Data headers go out as a separate buffer of the same write).
 #pragma once
 
 #include <atomic>
@@ -18,11 +20,14 @@ struct ServerOptions {
   int port = 8765;                 // Foxglove's default port for its WebSocket connection
   size_t client_queue_bytes = 32u << 20;  // about ten JSON scans of an HDL-64E
   std::string name = "dlslot-foxglove";
+  int send_nice = 19;  // the server thread's nice value (it only feeds clients): the pipeline goes first
 };
 
 struct AdvertisedChannel {
   uint32_t id;
-  std::string topic, schema_name, schema;  // schema: JSON Schema text
+  std::string topic, schema_name, schema;  // schema: JSON Schema text, or a ROS 1 message definition
+  std::string encoding = "json";           // the messages' encoding: "json" or "ros1"
+  std::string schema_encoding = "jsonschema";  // "jsonschema" or "ros1msg"
 };
 
 struct ServerStats {
@@ -43,8 +48,10 @@ class Server {
 
   // True when any client subscribes to the channel (so its messages are worth building).
   bool subscribed(uint32_t channel) const;
-  // Queues `payload` for every subscriber of `channel`; time_ns is the receive time.
-  void publish(uint32_t channel, uint64_t time_ns, std::shared_ptr<const std::string> payload);
+  // Queues `payload` for every subscriber of `channel`; time_ns is the receive time. The server
+  // owns the bytes from then on (the last client to send them may take them over): the caller
+  // must not change them.
+  void publish(uint32_t channel, uint64_t time_ns, std::shared_ptr<std::string> payload);
   ServerStats stats() const;
   int port() const;  // the bound port (useful with port 0)
 

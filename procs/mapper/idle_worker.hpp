@@ -1,0 +1,63 @@
+// One thread that runs posted jobs in order, for the mapper's work that must never hold the
+// pipeline up. The mapper shares two cores with the odometry and the back end, whose frames set
+// the lockstep rate; its keyframes and loop closure only have to be done by the end of the run.
+// So the thread runs at SCHED_IDLE (Linux): the scheduler gives it a core only when no normal
+// thread wants one, and the mapper uses the cores' idle time instead of taking theirs. The queue
+// is bounded: post() blocks while `capacity` jobs wait (the caller decides what to do before
+// that, see backlog()), and drain() first lifts the thread back to normal priority so that the
+// catch-up at the end of a run does not wait for idle time that a busy machine may not have.
+// Inline mode (threaded = false) runs each job in post(): offline rebuilds are reproducible.
+#pragma once
+
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace dlslot::mapper {
+
+class IdleWorker {
+ public:
+  // name: for messages; capacity >= 1: jobs that may wait; idle_priority: SCHED_IDLE for the thread.
+  IdleWorker(std::string name, bool threaded, size_t capacity, bool idle_priority);
+  ~IdleWorker();  // runs what is queued, then stops
+  IdleWorker(const IdleWorker&) = delete;
+  IdleWorker& operator=(const IdleWorker&) = delete;
+
+  // Queues `job` (runs it now when inline); blocks while the queue is full.
+  void post(std::function<void()> job);
+  // Back to normal priority, then waits until every job posted so far has run.
+  void drain();
+  // Jobs waiting (not counting the one running), and the most that ever waited.
+  size_t backlog() const;
+  size_t maxBacklog() const;
+  size_t capacity() const { return capacity_; }
+  // Empty when the thread runs at the priority asked for; else why not (e.g. not permitted).
+  std::string priorityError() const;
+  // CPU milliseconds the thread has used so far (0 inline).
+  double cpuMs() const;
+  // What jobs threw (a job's exception is caught on the thread, kept here, and the next job runs).
+  std::vector<std::string> takeErrors();
+
+ private:
+  void work();
+  void setPriority(bool idle);
+
+  std::string name_;
+  bool threaded_;
+  size_t capacity_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_, space_, idle_;
+  std::deque<std::function<void()>> queue_;
+  size_t max_backlog_ = 0;
+  bool busy_ = false, stop_ = false;
+  std::string priority_error_;
+  std::vector<std::string> errors_;
+  std::thread thread_;
+};
+
+}  // namespace dlslot::mapper

@@ -596,4 +596,9 @@ TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
   // The odometry covariance scale: two factors, translation and rotation.
   EXPECT_EQ(c.odometry_covariance_scale, Eigen::Vector2d(5.0, 20.0));
   for (const char* bad : {"20", "[5, 20, 1]", "[5, 0]"}) expectRefused("odometry_covariance_scale", bad);
+  // The odometry factor's consistency test: a probability strictly inside (0, 1), a support >= 1.
+  EXPECT_TRUE(c.odometry_check.enabled);
+  EXPECT_EQ(c.odometry_check.probability, 0.9999);
+  for (const char* bad : {"0", "1", "1.5"}) expectRefused("odometry_check_probability", bad);
+  expectRefused("odometry_check_min_support", "0");
 }

@@ -157,6 +157,13 @@ void writeRun(const std::string& path, bool with_truth = true) {
     slot.num_tracks = static_cast<int32_t>(slot.tracks.size());
     slot.timings = {timing("total", 5.0), timing("solve", 4.0)};
     slot.num_timings = 2;
+    // The backend's odometry test: untested on the first frame, contradicted on frames 10 and 11.
+    const bool contradicted = t == 10 || t == 11;
+    slot.odometry_check = t == 0 ? slot_state_t::ODOMETRY_UNTESTED
+                                 : contradicted ? slot_state_t::ODOMETRY_DOWNWEIGHTED : slot_state_t::ODOMETRY_CONSISTENT;
+    slot.odometry_disagreement_m = contradicted ? 2.0 + 0.1 * (t - 10) : 0.01;
+    slot.odometry_chi2 = contradicted ? 900.0 : 1.0;
+    slot.odometry_inflation = contradicted ? 5000.0 : 1.0;
     write(log, "SLOT_STATE", slot, utime);
   }
   process_status_t status{};
@@ -285,6 +292,13 @@ TEST_F(EvalLog, ARecordedRunGivesTheKnownMetrics) {
   const std::string report = slurp(dir_ / "out" / "report.md");
   EXPECT_NE(report.find("| slot (primary)"), std::string::npos) << report;
   EXPECT_NE(report.find("process odometry: 30 frames"), std::string::npos) << report;
+  // The backend's test of the odometry, counted from SLOT_STATE and said on the summary line.
+  EXPECT_EQ(*value(json, "ego.odometry_tested_frames"), kFrames - 1);
+  EXPECT_EQ(*value(json, "ego.odometry_disagreement_frames"), 2);
+  EXPECT_EQ(*value(json, "ego.odometry_downweighted_frames"), 2);
+  EXPECT_NEAR(*value(json, "ego.odometry_max_disagreement_m"), 2.1, 1e-9);
+  EXPECT_NE(r.out.find("contradicted the odometry on 2 scans"), std::string::npos) << r.out;
+  EXPECT_NE(report.find("frames 10 11."), std::string::npos) << report;
 }
 
 TEST_F(EvalLog, ExportedFilesEvaluateLikeTheLog) {

@@ -267,7 +267,8 @@ Refusal checkLayout(const slot_state_t*, const void* data, size_t size) {
             c.skip(36 * kF64 + kI8 + kI32 + kI64, "ego_covariance, smoothed") && pose(c, "smoothed_pose") &&
             c.skip(2 * kI8, "missing flags") && c.count(&n, kMinTrack, "num_tracks");
   for (int32_t i = 0; ok && i < n; ++i) ok = track(c);
-  (void)(ok && c.skip(kI32 + 2 * kF64, "iterations, costs") && timings(c));
+  (void)(ok && c.skip(kI32 + 2 * kF64, "iterations, costs") && timings(c) &&
+         c.str("status_text") && c.skip(kI8 + 3 * kF64 + kI32, "odometry check"));
   return c.finish();
 }
 
@@ -400,6 +401,11 @@ Refusal checkContent(const slot_state_t& m) {
   if (Refusal r = checkNonNegative(m.iterations, "iterations")) return r;
   if (!std::isfinite(m.initial_cost)) return nonFinite("initial_cost");
   if (!std::isfinite(m.final_cost)) return nonFinite("final_cost");
+  if (Refusal r = checkStatus(m.odometry_check, slot_state_t::ODOMETRY_DISAGREED, "odometry_check")) return r;
+  if (!std::isfinite(m.odometry_chi2)) return nonFinite("odometry_chi2");
+  if (!std::isfinite(m.odometry_disagreement_m)) return nonFinite("odometry_disagreement_m");
+  if (!std::isfinite(m.odometry_inflation)) return nonFinite("odometry_inflation");
+  if (Refusal r = checkNonNegative(m.odometry_support, "odometry_support")) return r;
   return checkTimings(m.timings);
 }
 

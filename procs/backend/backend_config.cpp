@@ -78,6 +78,13 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   require(scale.size() == 2 && scale[0] > 0.0 && scale[1] > 0.0, s, "odometry_covariance_scale",
           "two factors > 0 [translation, rotation]");
   c.odometry_covariance_scale = Eigen::Vector2d(scale[0], scale[1]);
+  s.get("odometry_check", c.odometry_check.enabled);
+  s.get("odometry_check_probability", c.odometry_check.probability);
+  require(c.odometry_check.probability > 0.0 && c.odometry_check.probability < 1.0, s, "odometry_check_probability",
+          "a probability between 0 and 1 (exclusive)");
+  s.get("odometry_check_min_support", c.odometry_check.min_support);
+  require(c.odometry_check.min_support >= 1, s, "odometry_check_min_support", "an object count >= 1");
+  s.get("odometry_check_downweight", c.odometry_check.downweight);
   s.get("observation_loss", c.observation_loss);
   require(c.observation_loss == "none" || c.observation_loss == "huber" || c.observation_loss == "cauchy", s,
           "observation_loss", "none, huber or cauchy");

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "backend/object_registration.hpp"
+#include "backend/odometry_consistency.hpp"
 #include "backend/se3.hpp"
 #include "dlslot/config.hpp"
 
@@ -52,6 +53,9 @@ struct BackendConfig {
   // instead of odometry_sigma when it is valid.
   bool use_odometry_covariance = true;
   Eigen::Vector2d odometry_covariance_scale = Eigen::Vector2d(5.0, 5.0);  // translation, rotation
+  // The odometry factor tested against the motion the landmarks and tracked objects imply, and
+  // down-weighted where they disagree beyond both covariances (odometry_consistency.hpp).
+  ConsistencyOptions odometry_check;
 
   // Per-object registration (object_registration.hpp): the classes whose own points, registered
   // from scan to scan, measure their pose changes (eq. 10's c) beside the boxes; empty: none, the

@@ -73,6 +73,13 @@ slot_state_t toMsg(const BackendOutput& out, const std::string& mode) {
                                          {"marginalize", out.stats.marginalize_ms},
                                          {"total", out.stats.total_ms}});
   m.num_timings = static_cast<int32_t>(m.timings.size());
+  const OdometryCheck& c = out.odometry_check;
+  m.odometry_check = static_cast<int8_t>(c.outcome);
+  m.odometry_chi2 = c.chi2;
+  m.odometry_disagreement_m = c.disagreement_m;
+  m.odometry_inflation = c.inflation;
+  m.odometry_support = c.support;
+  m.status_text = c.text();
   return m;
 }
 

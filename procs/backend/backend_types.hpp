@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "backend/object_registration.hpp"
+#include "backend/odometry_consistency.hpp"
 #include "backend/se3.hpp"
 #include <array>
 #include <memory>
@@ -81,6 +82,9 @@ struct BackendOutput {
   std::optional<SmoothedPose> smoothed;  // the frame that left the window with this solve
   bool odometry_missing = false;
   bool associations_missing = false;
+  // This frame's odometry factor against the motion its landmarks and objects imply
+  // (odometry_consistency.hpp): untested, consistent, or down-weighted.
+  OdometryCheck odometry_check;
   std::vector<TrackEstimate> tracks;
   SolveStats stats;
   int static_to_dynamic = 0;  // landmarks that turned dynamic this frame

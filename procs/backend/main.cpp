@@ -96,6 +96,15 @@ void report(ProcessStatus& status, const BackendOutput& out) {
     if (out.registrations[k])
       status.count(std::string("registration_") + toString(static_cast<RegistrationOutcome>(k)), out.registrations[k]);
   if (out.registration_no_previous) status.count("registration_no_previous", out.registration_no_previous);
+  // The odometry factor's test (odometry_consistency.hpp): frames tested, and those where the
+  // landmarks and objects disagreed with it beyond both covariances (down-weighted or reported).
+  const OdometryCheck& c = out.odometry_check;
+  if (c.outcome != OdometryCheckOutcome::kUntested) status.count("odometry_tested");
+  if (c.disagreed()) {
+    status.count("odometry_disagreement_frames");
+    if (c.outcome == OdometryCheckOutcome::kDownweighted) status.count("odometry_downweighted_frames");
+    status.warn("frame " + std::to_string(out.frame) + ": " + c.text());
+  }
 }
 
 // Offline: every ODOMETRY and ASSOCIATIONS event of a log, joined by frame, in frame order.
@@ -160,6 +169,9 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   std::array<int64_t, kNumRegistrationOutcomes> registrations{};
   int64_t registration_no_previous = 0, registration_points = 0;
   double registration_residual_sq = 0;
+  int odometry_tested = 0, odometry_disagreed = 0, odometry_downweighted = 0;
+  double odometry_max_disagreement_m = 0;
+  std::vector<double> odometry_chi2;  // of the tested frames
   std::map<int, slot_state_t> states;
   std::map<int, int> inputs_left;  // frame -> its input events not yet copied to the output
   for (const Joiner::Joined& j : joiner.flush()) {
@@ -178,6 +190,15 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
     registration_no_previous += result.registration_no_previous;
     registration_points += result.registration_points;
     registration_residual_sq += result.registration_residual_sq;
+    const OdometryCheck& check = result.odometry_check;
+    odometry_tested += check.outcome != OdometryCheckOutcome::kUntested;
+    if (check.outcome != OdometryCheckOutcome::kUntested) odometry_chi2.push_back(check.chi2);
+    if (check.disagreed()) {
+      ++odometry_disagreed;
+      odometry_downweighted += check.outcome == OdometryCheckOutcome::kDownweighted;
+      odometry_max_disagreement_m = std::max(odometry_max_disagreement_m, check.disagreement_m);
+      std::printf("  frame %d: %s\n", j.frame, check.text().c_str());
+    }
     states[j.frame] = toMsg(result, toString(config.mode));
     inputs_left[j.frame] = (j.a ? 1 : 0) + (j.b ? 1 : 0);
   }
@@ -236,6 +257,14 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   for (int k = 0; k < kNumRegistrationOutcomes; ++k)
     std::printf(" %s %lld", toString(static_cast<RegistrationOutcome>(k)), static_cast<long long>(registrations[k]));
   std::printf(", no previous scan %lld\n", static_cast<long long>(registration_no_previous));
+  std::sort(odometry_chi2.begin(), odometry_chi2.end());
+  const auto chi2At = [&](double q) {
+    return odometry_chi2.empty() ? 0.0 : odometry_chi2[static_cast<size_t>(q * (odometry_chi2.size() - 1))];
+  };
+  std::printf("  odometry tested against the objects on %d frames (chi-square median %.2f, p99 %.2f, max %.2f): "
+              "disagreed on %d (down-weighted %d), up to %.3f m\n",
+              odometry_tested, chi2At(0.5), chi2At(0.99), chi2At(1.0), odometry_disagreed, odometry_downweighted,
+              odometry_max_disagreement_m);
   int64_t attempts = 0;
   for (int k = 0; k < kNumRegistrationOutcomes; ++k) attempts += registrations[k];
   const int64_t ok = registrations[0] + registrations[1];

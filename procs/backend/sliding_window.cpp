@@ -65,7 +65,7 @@ BackendOutput SlidingWindow::process(const BackendInput& in) {
   out.odometry_missing = !in.odometry.has_value();
   out.associations_missing = in.associations_missing;
 
-  addEgoFrame(in);
+  addEgoFrame(in, out);
   if (config_.mode != Mode::kOdometryOnly) {
     addObservations(in, out);
     out.static_to_dynamic = switchMovingLandmarks();
@@ -84,7 +84,7 @@ BackendOutput SlidingWindow::process(const BackendInput& in) {
 
 // ---- step 1: the ego pose and its odometry factor (eq. 8) ----
 
-void SlidingWindow::addEgoFrame(const BackendInput& in) {
+void SlidingWindow::addEgoFrame(const BackendInput& in, BackendOutput& out) {
   const bool have_odometry = in.odometry.has_value();
   const Pose delta = have_odometry ? in.odometry->delta : last_delta_;
   Pose X;
@@ -94,6 +94,39 @@ void SlidingWindow::addEgoFrame(const BackendInput& in) {
     X = fromBlock(frames_.back().pose->data()) * delta;
   } else {
     X = in.odometry->pose;  // two-stage / odometry-only: the odometry's pose as it is
+  }
+  const bool odometry_factor = config_.mode == Mode::kSlot && !frames_.empty();
+  Matrix6 S = sqrtInformation(config_.odometry_sigma);
+  if (odometry_factor) {
+    const bool degraded = !have_odometry || !in.odometry->ok;
+    if (degraded) {
+      // A missing or fallen-back odometry: the constant-velocity prediction with the configured
+      // sigmas times degraded_odometry_scale. Not the message's covariance: a fallback publishes
+      // its own wide placeholder (1 m), and scaled again it let moving objects alone, which
+      // cannot fix the ego's velocity, push a stopped ego along at 4 m/s.
+      S /= config_.degraded_odometry_scale;
+    } else if (config_.use_odometry_covariance) {
+      Eigen::LLT<Matrix6> llt(in.odometry->covariance);
+      // S = L^-1 with Sigma = L L^T gives S^T S = Sigma^-1; the covariance D Sigma D, with D the
+      // translation and rotation scale factors, has S D^-1.
+      Vector6 scale;
+      scale << config_.odometry_covariance_scale.x() * Eigen::Vector3d::Ones(), config_.odometry_covariance_scale.y() * Eigen::Vector3d::Ones();
+      if (llt.info() == Eigen::Success && in.odometry->covariance.allFinite())
+        S = llt.matrixL().solve(Matrix6::Identity()) * scale.cwiseInverse().asDiagonal();
+    }
+    // The factor against the objects' view of the same motion. Only a frame that fails the test
+    // changes: its translation covariance times the inflation (S D^-1 as above, D = sqrt(k) on
+    // translation), its pose started from the objects' translation. A frame that passes keeps
+    // the factor and the start it had without the test, so its solution is bit-identical.
+    out.odometry_check = checkOdometryFactor(in, delta, S);
+    if (out.odometry_check.outcome == OdometryCheckOutcome::kDownweighted) {
+      Vector6 scale;
+      scale << std::sqrt(out.odometry_check.inflation) * Eigen::Vector3d::Ones(), Eigen::Vector3d::Ones();
+      S = S * scale.cwiseInverse().asDiagonal();
+      Pose T = delta;
+      T.translation() = out.odometry_check.translation;
+      X = fromBlock(frames_.back().pose->data()) * T;
+    }
   }
   EgoFrame f;
   f.frame = in.frame;
@@ -112,24 +145,54 @@ void SlidingWindow::addEgoFrame(const BackendInput& in) {
     addFactor(MarginalizationPrior::CreatePosePrior(X, sqrtInformation(config_.first_pose_sigma)), false, {x});
     return;
   }
-  Matrix6 S = sqrtInformation(config_.odometry_sigma);
-  const bool degraded = !have_odometry || !in.odometry->ok;
-  if (degraded) {
-    // A missing or fallen-back odometry: the constant-velocity prediction with the configured
-    // sigmas times degraded_odometry_scale. Not the message's covariance: a fallback publishes
-    // its own wide placeholder (1 m), and scaled again it let moving objects alone, which
-    // cannot fix the ego's velocity, push a stopped ego along at 4 m/s.
-    S /= config_.degraded_odometry_scale;
-  } else if (config_.use_odometry_covariance) {
-    Eigen::LLT<Matrix6> llt(in.odometry->covariance);
-    // S = L^-1 with Sigma = L L^T gives S^T S = Sigma^-1; the covariance D Sigma D, with D the
-    // translation and rotation scale factors, has S D^-1.
-    Vector6 scale;
-    scale << config_.odometry_covariance_scale.x() * Eigen::Vector3d::Ones(), config_.odometry_covariance_scale.y() * Eigen::Vector3d::Ones();
-    if (llt.info() == Eigen::Success && in.odometry->covariance.allFinite())
-      S = llt.matrixL().solve(Matrix6::Identity()) * scale.cwiseInverse().asDiagonal();
-  }
   addFactor(OdometryFactor::Create(delta, S), false, {x_prev, x});
+}
+
+OdometryCheck SlidingWindow::checkOdometryFactor(const BackendInput& in, const Pose& delta, const Matrix6& S) const {
+  const EgoFrame& prev = frames_.back();
+  const Pose X_prev = fromBlock(prev.pose->data());
+  const double dt = 1e-6 * static_cast<double>(in.utime - prev.utime);
+  const Eigen::Matrix3d R = delta.linear();
+  // A box's centre covariance in the lidar frame: the factor's sigmas along and across the box
+  // (observation_factor.hpp), grown with range as the factor's are.
+  const auto boxCovariance = [&](const Pose& b, const Vector6& sigma) -> Eigen::Matrix3d {
+    const Eigen::Vector3d s = sigma.head<3>() * noiseGrowth(b.translation().norm());
+    return b.linear() * s.cwiseAbs2().asDiagonal() * b.linear().transpose();
+  };
+  std::vector<MotionEvidence> evidence;
+  std::unordered_set<int> used;
+  for (const ObservationInput& obs : in.observations) {
+    // The objects the graph uses (initialized, confirmed), seen in the previous frame too.
+    if (obs.track_id < 0 || !obs.initialized || !obs.confirmed || !used.insert(obs.track_id).second) continue;
+    const auto it = tracks_.find(obs.track_id);
+    if (it == tracks_.end() || it->second.model == TrackModel::kNotInGraph) continue;
+    const Track& track = it->second;
+    const auto before = track.observations.find(prev.frame);
+    if (before == track.observations.end() || !before->second.in_graph) continue;
+    const bool moving = track.model == TrackModel::kDynamic;
+    if (moving && (!track.velocity || !(dt > 0))) continue;
+    const Pose& b_prev = before->second.b;
+    const Pose b_cur = obs.box.pose();
+    const Vector6& sigma = moving ? config_.observation_sigma : config_.landmark_sigma;
+    MotionEvidence e;
+    e.track_id = obs.track_id;
+    e.moving = moving;
+    e.translation = b_prev.translation() - R * b_cur.translation();
+    e.covariance = boxCovariance(b_prev, sigma) + R * boxCovariance(b_cur, sigma) * R.transpose();
+    if (moving) {
+      // Its velocity before this frame (world), and eq. 11's sigma: how much its per-frame motion
+      // may change from one frame to the next, along and across its heading.
+      e.translation += X_prev.linear().transpose() * *track.velocity * dt;
+      const Eigen::Vector3d s = config_.constant_velocity_sigma.head<3>();
+      e.covariance += b_prev.linear() * s.cwiseAbs2().asDiagonal() * b_prev.linear().transpose();
+    }
+    evidence.push_back(e);
+  }
+  // The odometry's translation covariance from the factor's information S^T S; the factor's
+  // error (X_{t-1}^-1 X_t)^-1 T has its translation in the axes of frame t, turned into t-1's.
+  const Matrix6 covariance = (S.transpose() * S).inverse();
+  const Eigen::Matrix3d C = R * covariance.topLeftCorner<3, 3>() * R.transpose();
+  return checkOdometry(delta.translation(), C, evidence, config_.odometry_check);
 }
 
 // ---- step 2: observations, eq. 9-11 with eq. 12's membership ----

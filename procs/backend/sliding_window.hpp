@@ -86,7 +86,10 @@ class SlidingWindow {
     Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
   };
 
-  void addEgoFrame(const BackendInput& in);
+  void addEgoFrame(const BackendInput& in, BackendOutput& out);
+  // The objects' view of the ego's translation since the previous frame, and the test of the
+  // odometry factor's (delta, sqrt information S) against it (odometry_consistency.hpp).
+  OdometryCheck checkOdometryFactor(const BackendInput& in, const Pose& delta, const Matrix6& S) const;
   void addObservations(const BackendInput& in, BackendOutput& out);
   void startTrack(Track& track, int frame);
   // Registers the object's points of this frame to those of the previous one (when it has both).

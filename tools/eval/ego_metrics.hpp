@@ -70,4 +70,13 @@ struct EgoMetrics {
 std::optional<double> implausibleSpeedJumps(const Trajectory& est);
 EgoMetrics evaluateEgo(const Trajectory& est, const Trajectory& gt);
 
+// The backend's test of each frame's odometry factor against its landmarks and tracked objects
+// (SLOT_STATE odometry_check): frames tested, those where they disagreed beyond both
+// covariances, of them those down-weighted, and the largest disagreement.
+struct OdometryChecks {
+  int tested = 0, disagreed = 0, downweighted = 0;
+  double max_disagreement_m = 0;
+  std::vector<int> disagreed_frames;
+};
+
 }  // namespace dlslot::eval

@@ -47,6 +47,7 @@ struct RunData {
   std::optional<FrameAccounting> frames;         // where every played frame went (a recorded run)
   std::map<std::string, RssSummary> memory;      // process -> resident memory over the run
   std::optional<MapMetrics> map;                 // --map
+  std::optional<OdometryChecks> odometry_checks;  // a recorded run with SLOT_STATE
 };
 
 struct EvalOptions {
@@ -80,6 +81,7 @@ struct Metrics {
   std::optional<FrameAccounting> frames;
   std::map<std::string, RssSummary> memory;
   std::optional<MapMetrics> map;
+  std::optional<OdometryChecks> odometry_checks;
 };
 
 std::string primarySource(const std::map<std::string, Trajectory>& sources);

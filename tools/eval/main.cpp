@@ -397,6 +397,7 @@ int run(int argc, char** argv) {
     for (const auto& [frame, t] : tracks) ego_poses[frame] = t.ego;
     run.timing_ms = log->timing_ms;
     run.frame_counts = log->frame_counts;
+    run.odometry_checks = log->odometry_checks;
     addProcessNotes(*log, run);
     std::vector<std::string> pipeline;
     for (const std::string p : {"detector", "odometry", "tracker", "backend", "renderer", "mapper"})

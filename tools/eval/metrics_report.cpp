@@ -235,6 +235,12 @@ std::string metricsJson(const Metrics& m) {
   const auto primary = m.ego.find(m.primary_source);
   kv.emplace_back("ego.source", m.primary_source.empty() ? "null" : quoted(m.primary_source));
   ego_entries("ego.", primary != m.ego.end() ? primary->second : std::nullopt);
+  // The backend's test of the odometry factor (null without SLOT_STATE).
+  const auto& oc = m.odometry_checks;
+  kv.emplace_back("ego.odometry_tested_frames", num(oc ? Opt(oc->tested) : std::nullopt));
+  kv.emplace_back("ego.odometry_disagreement_frames", num(oc ? Opt(oc->disagreed) : std::nullopt));
+  kv.emplace_back("ego.odometry_downweighted_frames", num(oc ? Opt(oc->downweighted) : std::nullopt));
+  kv.emplace_back("ego.odometry_max_disagreement_m", num(oc ? Opt(oc->max_disagreement_m) : std::nullopt));
   for (const auto& [name, e] : m.ego) ego_entries("sources." + name + ".", e);
   for (const auto& [key, v] : trackingValues(m.tracking)) kv.emplace_back("tracking." + key, num(v));
   for (const auto& [key, v] : trackingValues(m.tracking_iou)) kv.emplace_back("tracking_iou." + key, num(v));
@@ -315,6 +321,17 @@ std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plo
         << "ATE: RMSE of the position after SE(3) Umeyama alignment (unaligned: in the world of the first "
            "scan, the ground truth anchored at the run's first frame when the run started later). RPE: RMSE over frame pairs 1 and 10 scans apart. Velocity err: the RMSE of the ego's velocity over 5 scans (the span of the backend's object velocities, whose error over ground includes it). t_rel / r_rel: KITTI devkit segments "
            "of 100..800 m starting every 10 frames (and 10..80 m), poses in the lidar frame.\n\n";
+  }
+  if (const auto& oc = m.odometry_checks) {
+    out << "The backend tested the odometry against the motion of its landmarks and tracked objects on " << oc->tested
+        << " frames: they disagreed beyond both covariances on " << oc->disagreed << " (odometry down-weighted on "
+        << oc->downweighted << ")";
+    if (oc->disagreed > 0) {
+      out << ", by up to " << cell(oc->max_disagreement_m, "%.3f") << " m; frames";
+      for (size_t i = 0; i < oc->disagreed_frames.size() && i < 50; ++i) out << " " << oc->disagreed_frames[i];
+      if (oc->disagreed_frames.size() > 50) out << " ...";
+    }
+    out << ".\n\n";
   }
   out << "## Tracking (bird's-eye view, each scan's lidar frame)\n\n";
   if (!m.tracking) {
@@ -435,6 +452,10 @@ std::string summaryLine(const Metrics& m) {
   if (primary != m.ego.end() && primary->second && primary->second->implausible_frames.value_or(0) > 0)
     out << "; ego speed jumps above 2 g on " << static_cast<int>(*primary->second->implausible_frames)
         << " scans (a lost or re-anchored ego: check the odometry's warnings)";
+  if (m.odometry_checks && m.odometry_checks->disagreed > 0)
+    out << "; landmarks and objects contradicted the odometry on " << m.odometry_checks->disagreed
+        << " scans (down-weighted on " << m.odometry_checks->downweighted << ", by up to "
+        << cell(m.odometry_checks->max_disagreement_m, "%.2f") << " m)";
   if (m.tracking)
     out << "; MOTA " << cell(m.tracking->clear.mota, "%.3f") << ", HOTA "
         << cell(m.tracking->hota ? Opt(m.tracking->hota->hota) : std::nullopt, "%.3f") << ", IDSW "

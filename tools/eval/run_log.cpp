@@ -109,6 +109,14 @@ class LogReader {
       slot_[m->frame] = {seconds(m->utime), fromMsg(m->ego_pose)};
       if (m->has_smoothed) smoothed_[m->smoothed_frame] = {seconds(m->smoothed_utime), fromMsg(m->smoothed_pose)};
       run_.tracks[m->frame] = tracksOf(*m, track_max_unseen_);
+      OdometryChecks& checks = run_.odometry_checks ? *run_.odometry_checks : run_.odometry_checks.emplace();
+      checks.tested += m->odometry_check != slot_state_t::ODOMETRY_UNTESTED;
+      if (m->odometry_check == slot_state_t::ODOMETRY_DOWNWEIGHTED || m->odometry_check == slot_state_t::ODOMETRY_DISAGREED) {
+        ++checks.disagreed;
+        checks.downweighted += m->odometry_check == slot_state_t::ODOMETRY_DOWNWEIGHTED;
+        checks.max_disagreement_m = std::max(checks.max_disagreement_m, m->odometry_disagreement_m);
+        checks.disagreed_frames.push_back(m->frame);
+      }
       addTimings(run_, "backend", m->timings);
       run_.frames.insert(m->frame);
     } else if (c == ch_.associations) {

@@ -9,6 +9,7 @@
 #include "dlslot/config.hpp"
 #include "dlslot/process_status_t.hpp"
 #include "dlslot/timing_stats.hpp"
+#include "ego_metrics.hpp"
 #include "tracking_frames.hpp"
 #include "trajectory.hpp"
 
@@ -35,6 +36,7 @@ struct RunLog {
   std::map<std::string, process_status_t> last_status;  // by process name
   // Resident memory over the run by process: (PROCESS_STATUS utime in s, counter rss_kb).
   std::map<std::string, std::vector<std::pair<double, int64_t>>> rss_kb;
+  std::optional<OdometryChecks> odometry_checks;  // from SLOT_STATE, when the log has any
 };
 
 // Reads every event; throws InputError naming the file for a missing, empty, truncated or corrupt

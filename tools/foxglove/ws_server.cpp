@@ -5,6 +5,10 @@
 #include <websocketpp/server.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <map>
 #include <mutex>
@@ -227,7 +231,14 @@ Server::Server(ServerOptions options, std::vector<AdvertisedChannel> channels) :
   }
   s.timer = std::make_unique<asio::steady_timer>(s.ws.get_io_service());
   asio::post(s.ws.get_io_service(), [&s] { s.tick(); });
-  s.thread = std::thread([&s] { s.ws.run(); });
+  s.thread = std::thread([&s] {
+    // The lowest CPU priority for the sending (nice is per thread on Linux): on a full machine the
+    // pipeline's processes get the cores first and the clients are fed when they are idle, their
+    // drop-oldest queues absorbing the wait. The LCM side (receiving, checking, building each
+    // message once) keeps the process's priority, so the bridge never loses a message on its socket.
+    setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), s.opt.send_nice);
+    s.ws.run();
+  });
 }
 
 Server::~Server() {

@@ -20,6 +20,7 @@ struct ServerOptions {
   int port = 8765;                 // Foxglove's default port for its WebSocket connection
   size_t client_queue_bytes = 32u << 20;  // about ten JSON scans of an HDL-64E
   std::string name = "dlslot-foxglove";
+  int send_nice = 19;  // the server thread's nice value (it only feeds clients): the pipeline goes first
 };
 
 struct AdvertisedChannel {

@@ -98,9 +98,7 @@ TEST(MessageGuard, CountsAndStringLengthsAreCheckedBeforeLcmGenAllocates) {
   expectStructuralRefusals(sampleGroundTruth(4), kGroundTruthStringAt, 3);
   expectStructuralRefusals(sampleOdometry(4), kOdometryStringAt, 2);
   expectStructuralRefusals(sampleAssociations(4), kAssociationsStringAt, 8);
-  // SLOT_STATE's num_timings is followed by an empty status_text (its length and terminating
-  // zero, 5 bytes) and the odometry check (int8, 3 doubles, int32): 34 bytes.
-  expectStructuralRefusals(sampleSlotState(4), kSlotStringAt, 4, encode(sampleSlotState(4)).size() - 4 - 34);
+  expectStructuralRefusals(sampleSlotState(4), kSlotStringAt, 4, slotStateTimingsCountAt(encode(sampleSlotState(4))));
   expectStructuralRefusals(sampleStatus(), kStatusStringAt, 8);
   // A NUL inside a string, or none at its end (lcm-gen would not encode it back).
   Bytes b = encode(sampleScan(4));

@@ -139,6 +139,11 @@ inline associations_t sampleAssociations(int frame) {
 }
 constexpr size_t kAssociationsPoseAt = 20, kAssociationsStringAt = 76;
 
+// Where an encoded SLOT_STATE keeps num_timings (its last count): before an empty status_text
+// (its length and terminating zero, 5 bytes) and the odometry check (int8, 3 doubles, int32):
+// 34 bytes and the count's own 4 from the end.
+inline size_t slotStateTimingsCountAt(const Bytes& encoded) { return encoded.size() - 4 - 34; }
+
 inline slot_state_t sampleSlotState(int frame) {
   slot_state_t m{};
   m.utime = 1000 + frame;

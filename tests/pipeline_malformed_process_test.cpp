@@ -64,7 +64,8 @@ std::vector<Malformed> badMessagesFor(const std::string& channel, int f) {
   }
   if (channel == "SLOT_STATE") {
     const Bytes b = encode(sampleSlotState(f));
-    return structuralVariants(b, kSlotStringAt) + frameVariants(b) + std::vector<Malformed>{nanPose(b, kSlotPoseAt)};
+    return structuralVariants(b, kSlotStringAt, slotStateTimingsCountAt(b)) + frameVariants(b) +
+           std::vector<Malformed>{nanPose(b, kSlotPoseAt)};
   }
   // PROCESS_STATUS
   process_status_t nan = sampleStatus();

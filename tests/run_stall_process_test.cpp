@@ -24,26 +24,39 @@ pid_t childNamed(pid_t parent, const std::string& comm) {
   return -1;
 }
 
+// `frames` of the intersection simulated into OUT/data; dlslot-run's arguments for them (into
+// OUT/run, no renderer, no evaluation) with `extra`.
+std::vector<std::string> runOnSimulated(const std::string& out, int frames, const std::vector<std::string>& extra) {
+  ChildProcess sim({bin("dlslot-sim"), "--scenario", "intersection", "--frames", std::to_string(frames), "--seed", "3",
+                    "--out", out + "/data"},
+                   out + "/sim.log");
+  EXPECT_EQ(sim.wait(300), 0) << sim.output();
+  std::vector<std::string> a = {bin("dlslot-run"), "--config", config(), "--kitti", out + "/data", "--detections",
+                                out + "/data/detections/sim", "--out", out + "/run", "--quiet", "--no-render",
+                                "--no-eval"};
+  a.insert(a.end(), extra.begin(), extra.end());
+  return a;
+}
+
+// The run's odometry once about three scans (5 MB) are in the run's log: mid-run, whatever the
+// machine's speed (lockstep plays ~30 frames a second). -1: the run or its odometry is gone.
+pid_t odometryMidRun(ChildProcess& run, const std::string& out) {
+  const std::string log = out + "/run/run.lcmlog";
+  std::error_code ec;
+  for (int i = 0; i < 6000 && run.running() && !(fs::file_size(log, ec) >= 5'000'000 && !ec); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  return run.running() ? childNamed(run.pid(), "dlslot-odometry") : -1;
+}
+
 }  // namespace
 
 TEST(RunStallProcess, StoppedOdometryIsReportedByName) {
   ASSERT_TRUE(insidePrivateNetwork());
   const std::string out = scratchDir();
-  ChildProcess sim({bin("dlslot-sim"), "--scenario", "intersection", "--frames", "40", "--seed", "3", "--out",
-                    out + "/data"},
-                   out + "/sim.log");
-  ASSERT_EQ(sim.wait(300), 0) << sim.output();
   // Rate mode at a quarter of real time (40 frames in 16 s): the odometry is stopped mid-run, long
   // before the pipeline-wide stall timeout (60 s) could fire.
-  ChildProcess run({bin("dlslot-run"), "--config", config(), "--kitti", out + "/data", "--detections",
-                    out + "/data/detections/sim", "--out", out + "/run", "--speed", "0.25", "--quiet", "--no-render",
-                    "--no-eval", "--heartbeat-timeout", "3"},
-                   out + "/run.log");
-  for (int i = 0; i < 600 && !fs::exists(out + "/run/logs/player.log"); ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  std::this_thread::sleep_for(std::chrono::seconds(2));
-  ASSERT_TRUE(run.running()) << run.output();
-  const pid_t odometry = childNamed(run.pid(), "dlslot-odometry");
+  ChildProcess run(runOnSimulated(out, 40, {"--speed", "0.25", "--heartbeat-timeout", "3"}), out + "/run.log");
+  const pid_t odometry = odometryMidRun(run, out);
   ASSERT_GT(odometry, 0) << run.output();
 
   const auto stopped_at = std::chrono::steady_clock::now();
@@ -72,19 +85,8 @@ TEST(RunStallProcess, StoppedOdometryIsReportedByName) {
 TEST(RunStallProcess, SlowOdometryInLockstepLosesNothing) {
   ASSERT_TRUE(insidePrivateNetwork());
   const std::string out = scratchDir();
-  ChildProcess sim({bin("dlslot-sim"), "--scenario", "intersection", "--frames", "30", "--seed", "3", "--out",
-                    out + "/data"},
-                   out + "/sim.log");
-  ASSERT_EQ(sim.wait(300), 0) << sim.output();
-  ChildProcess run({bin("dlslot-run"), "--config", config(), "--kitti", out + "/data", "--detections",
-                    out + "/data/detections/sim", "--out", out + "/run", "--quiet", "--no-render", "--no-map",
-                    "--no-eval"},
-                   out + "/run.log");
-  for (int i = 0; i < 600 && !fs::exists(out + "/run/logs/player.log"); ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  std::this_thread::sleep_for(std::chrono::seconds(2));
-  ASSERT_TRUE(run.running()) << run.output();
-  const pid_t odometry = childNamed(run.pid(), "dlslot-odometry");
+  ChildProcess run(runOnSimulated(out, 60, {"--no-map"}), out + "/run.log");
+  const pid_t odometry = odometryMidRun(run, out);
   ASSERT_GT(odometry, 0) << run.output();
   ASSERT_EQ(kill(odometry, SIGSTOP), 0);
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));

@@ -5,19 +5,35 @@
 #include <stdexcept>
 
 namespace dlslot::mapper {
+namespace {
 
-BoxCutter::BoxCutter(const std::vector<Box>& boxes, double reach_m)
-    : reach_(static_cast<float>(reach_m)), inverse_cell_(1.0f / kCellM) {
+std::vector<MovingBox> still(const std::vector<Box>& boxes) {
+  std::vector<MovingBox> out;
+  out.reserve(boxes.size());
+  for (const Box& b : boxes) out.push_back({b});
+  return out;
+}
+
+}  // namespace
+
+BoxCutter::BoxCutter(const std::vector<Box>& boxes, double reach_m) : BoxCutter(still(boxes), reach_m) {}
+
+BoxCutter::BoxCutter(const std::vector<MovingBox>& boxes, double reach_m, const SweepTiming& sweep)
+    : sweep_(sweep), reach_(static_cast<float>(reach_m)), inverse_cell_(1.0f / kCellM) {
   if (!(reach_m > 0)) throw std::invalid_argument("BoxCutter: reach must be > 0");
   if (boxes.size() > 65535) throw std::invalid_argument("BoxCutter: more than 65535 boxes");
   side_ = static_cast<int>(std::ceil(2 * reach_m / kCellM));
   std::vector<std::vector<uint16_t>> cells(static_cast<size_t>(side_) * side_);
-  for (const Box& b : boxes) {
+  const double t_max = sweep_.maxOffset();
+  for (const MovingBox& m : boxes) {
+    const Box& b = m.box;
     const uint16_t index = static_cast<uint16_t>(cuts_.size());
-    cuts_.push_back({b.center.cast<float>(), 0.5f * b.size.cast<float>(), static_cast<float>(std::cos(b.yaw)),
-                     static_cast<float>(std::sin(b.yaw))});
-    // The cells the footprint's bounding circle reaches (a cell is listed if it may hold a point inside).
-    const double r = 0.5 * b.size.head<2>().norm();
+    cuts_.push_back({b.center.cast<float>(), 0.5f * b.size.cast<float>(), m.velocity.cast<float>(),
+                     static_cast<float>(std::cos(b.yaw)), static_cast<float>(std::sin(b.yaw)),
+                     static_cast<float>(m.yaw_rate)});
+    // The cells the footprint's bounding circle reaches over the sweep (a cell is listed if it may
+    // hold a point inside).
+    const double r = 0.5 * b.size.head<2>().norm() + t_max * m.velocity.head<2>().norm();
     const auto clampCell = [&](double v) {
       return std::clamp(static_cast<int>(std::floor((v + reach_m) / kCellM)), 0, side_ - 1);
     };

@@ -53,17 +53,48 @@ void Mapper::add(MapperInput in) {
     pending_.pop_front();
     // The removal boxes are decided here (the tracks' history lives on this thread); the points are
     // handled on the keyframe thread.
-    auto boxes = std::make_shared<std::vector<Box>>(boxes_.removalBoxes(job->frame, job->utime * 1e-6));
+    auto boxes = std::make_shared<std::vector<MovingBox>>(lidarBoxes(*job));
     committer_->post([this, job, boxes] { commit(*job, *boxes); });
   }
   boxes_.forgetBefore(pending_.empty() ? in.frame - config_.decision_delay_frames : pending_.front().frame);
+}
+
+std::vector<MovingBox> Mapper::lidarBoxes(const Pending& p) const {
+  // The boxes in the keyframe's lidar frame, and in the lidar frames of the scans before and after
+  // it: their difference is each object's motion relative to the lidar (its own and the ego's),
+  // which places it at the firing time of each point (sweep_timing.hpp).
+  const auto inLidar = [&](int frame, int64_t utime, const Pose& pose) {
+    std::map<int, Box> out;
+    const Pose lidar_from_world = pose.inverse();
+    for (const Box& b : boxes_.removalBoxes(frame, utime * 1e-6)) out[b.id] = b.transformed(lidar_from_world);
+    return out;
+  };
+  const std::map<int, Box> here = inLidar(p.frame, p.utime, p.pose);
+  std::optional<std::pair<int64_t, std::map<int, Box>>> before, after;
+  if (const auto it = frames_.find(p.frame - 1); it != frames_.end())
+    before.emplace(it->second.first, inLidar(it->first, it->second.first, it->second.second));
+  if (const auto it = frames_.find(p.frame + 1); it != frames_.end())
+    after.emplace(it->second.first, inLidar(it->first, it->second.first, it->second.second));
+  std::vector<MovingBox> out;
+  out.reserve(here.size());
+  for (const auto& [id, b] : here) {
+    const Box* a = nullptr;
+    const Box* c = nullptr;
+    int64_t ta = p.utime, tc = p.utime;
+    if (before)
+      if (const auto it = before->second.find(id); it != before->second.end()) a = &it->second, ta = before->first;
+    if (after)
+      if (const auto it = after->second.find(id); it != after->second.end()) c = &it->second, tc = after->first;
+    out.push_back(movingBox(b, a ? *a : b, c ? *c : b, (tc - ta) * 1e-6));
+  }
+  return out;
 }
 
 void Mapper::finish() {
   while (!pending_.empty()) {
     auto job = std::make_shared<Pending>(std::move(pending_.front()));
     pending_.pop_front();
-    auto boxes = std::make_shared<std::vector<Box>>(boxes_.removalBoxes(job->frame, job->utime * 1e-6));
+    auto boxes = std::make_shared<std::vector<MovingBox>>(lidarBoxes(*job));
     committer_->post([this, job, boxes] { commit(*job, *boxes); });
   }
   committer_->drain();
@@ -110,7 +141,7 @@ std::vector<std::string> Mapper::takeErrors() {
   return out;
 }
 
-void Mapper::commit(Pending& p, const std::vector<Box>& world_boxes) {
+void Mapper::commit(Pending& p, const std::vector<MovingBox>& boxes) {
   // CPU time of this thread: at idle priority the wall time mostly counts waiting for a core.
   const double start = threadCpuMs();
   PointCloud scan;
@@ -137,12 +168,8 @@ void Mapper::commit(Pending& p, const std::vector<Box>& world_boxes) {
       ++n;
     }
   }
-  // The removal boxes in the lidar frame (box_cutter.hpp).
-  const Pose lidar_from_world = p.pose.inverse();
-  std::vector<Box> boxes;
-  boxes.reserve(world_boxes.size());
-  for (const Box& b : world_boxes) boxes.push_back(b.transformed(lidar_from_world));
-  const BoxCutter cutter(boxes, config_.max_range_m);
+  // The removal test (box_cutter.hpp), each box where it was at each point's firing time.
+  const BoxCutter cutter(boxes, config_.max_range_m, config_.sweep);
   PointCloud kept(4, n), gone(4, n);
   Eigen::Index nk = 0, ng = 0;
   for (Eigen::Index i = 0; i < n; ++i) (cutter.inside(scan.col(i).head<3>()) ? gone.col(ng++) : kept.col(nk++)) = scan.col(i);

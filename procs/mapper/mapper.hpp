@@ -110,8 +110,10 @@ class Mapper {
     PointCloud scan;        // when given decoded
     ScanLoader load_scan;   // else this
   };
-  // On the keyframe thread: decode, crop, remove what is inside `boxes` (world frame), insert.
-  void commit(Pending& p, const std::vector<Box>& boxes);
+  // On the caller's thread: the removal boxes of a keyframe, lidar frame, with their motion.
+  std::vector<MovingBox> lidarBoxes(const Pending& p) const;
+  // On the keyframe thread: decode, crop, remove what is inside `boxes` (lidar frame), insert.
+  void commit(Pending& p, const std::vector<MovingBox>& boxes);
   void applyLoopResult();
 
   MapperConfig config_;

@@ -25,6 +25,10 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
   c.remove_movable = remove == "movable";
   s.get("box_margin_m", c.box_margin_m);
   s.get("ground_clearance_m", c.ground_clearance_m);
+  s.get("sweep_period_s", c.sweep.period_s);
+  s.get("sweep_clockwise", c.sweep.clockwise);
+  if (!(c.sweep.period_s >= 0 && c.sweep.period_s <= 1.0))
+    throw ConfigError(s.file() + ": " + s.path() + ".sweep_period_s: expected a value in [0, 1] s (0: de-skewed scans)");
   s.get("min_new_fraction", c.min_new_fraction);
   s.get("decision_delay_frames", c.decision_delay_frames);
   s.get("follow_frames", c.follow_frames);

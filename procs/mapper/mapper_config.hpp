@@ -4,6 +4,7 @@
 #include <string>
 
 #include "dlslot/config.hpp"
+#include "dlslot/sweep_timing.hpp"
 
 namespace dlslot::mapper {
 
@@ -32,6 +33,9 @@ struct MapperConfig {
   bool remove_movable = false;  // remove: movable (every track) instead of dynamic (moving tracks)
   double box_margin_m = 0.3;
   double ground_clearance_m = 0.1;
+  // The scans' firing order: a moving object's points lie in its box moved by its motion relative to
+  // the lidar until the instant they were fired (sweep_timing.hpp); period 0: de-skewed scans.
+  SweepTiming sweep;
   double min_new_fraction = 0.01;  // a keyframe keeps its loop-closure cloud when this share of its points made new voxels
   int decision_delay_frames = 15, follow_frames = 15;
   double join_timeout_s = 5.0;  // live: how long a scan waits for its SLOT_STATE (and back)

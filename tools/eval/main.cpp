@@ -297,6 +297,8 @@ void addMap(const Options& o, const DataSet& data, RunData& run) {
     mapper.get("map_voxel_m", opt.voxel_m);
     mapper.get("min_range_m", opt.min_range_m);
     mapper.get("max_range_m", opt.max_range_m);
+    mapper.get("sweep_period_s", opt.sweep.period_s);
+    mapper.get("sweep_clockwise", opt.sweep.clockwise);
   }
   mm.score.voxel_m = opt.voxel_m;
   if (!o.kitti_root.empty()) {
@@ -319,7 +321,8 @@ void addMap(const Options& o, const DataSet& data, RunData& run) {
         k.T_map_lidar = poseFrom12(r, 3);
         const Frame f = reader.read(k.frame);
         k.scan = f.scan;
-        k.labels = f.labels;
+        k.labels = movingLabels(labels, k.frame, o.frame_period);
+        k.dontcare = f.dontcare;
         keyframes.push_back(std::move(k));
       }
       // Which tracks move: in the true world when there is one, else in the map's (the slice's approximate poses are

@@ -1,5 +1,6 @@
 #include "map_quality.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <unordered_map>
 #include <unordered_set>
@@ -27,6 +28,28 @@ std::set<int> movingTracks(const std::map<int, std::vector<Box>>& labels_by_fram
   return moving;
 }
 
+std::vector<MovingBox> movingLabels(const std::map<int, std::vector<Box>>& labels_by_frame, int frame, double dt) {
+  std::vector<MovingBox> out;
+  const auto here = labels_by_frame.find(frame);
+  if (here == labels_by_frame.end()) return out;
+  const auto find = [&](int f, int id) -> const Box* {
+    const auto it = labels_by_frame.find(f);
+    if (it == labels_by_frame.end() || id < 0) return nullptr;
+    for (const Box& b : it->second)
+      if (b.id == id) return &b;
+    return nullptr;
+  };
+  for (const Box& b : here->second) {
+    const Box* before = find(frame - 1, b.id);
+    const Box* after = find(frame + 1, b.id);
+    const Box& a = before ? *before : b;
+    const Box& c = after ? *after : b;
+    const int steps = (before ? 1 : 0) + (after ? 1 : 0);
+    out.push_back(steps ? movingBox(b, a, c, steps * dt) : MovingBox{b});
+  }
+  return out;
+}
+
 MapScore scoreMap(const PointCloud& map_points, const std::vector<MapKeyframe>& keyframes, const std::set<int>& moving,
                   const MapTruthOptions& o) {
   MapScore s;
@@ -37,9 +60,9 @@ MapScore scoreMap(const PointCloud& map_points, const std::vector<MapKeyframe>& 
   std::unordered_map<uint64_t, std::pair<int, int>> votes;  // voxel -> (static, dynamic) points
   const double lo = o.min_range_m * o.min_range_m, hi = o.max_range_m * o.max_range_m;
   for (const MapKeyframe& kf : keyframes) {
-    std::vector<const Box*> boxes;
-    for (const Box& b : kf.labels)
-      if (moving.count(b.id)) boxes.push_back(&b);
+    std::vector<const MovingBox*> boxes;
+    for (const MovingBox& b : kf.labels)
+      if (moving.count(b.box.id)) boxes.push_back(&b);
     for (Eigen::Index i = 0; i < kf.scan.cols(); ++i) {
       const Eigen::Vector3d p = kf.scan.col(i).head<3>().cast<double>();
       const double r2 = p.squaredNorm();
@@ -48,12 +71,20 @@ MapScore scoreMap(const PointCloud& map_points, const std::vector<MapKeyframe>& 
         const Eigen::Vector3d c = *o.T_cam_lidar * p;  // camera: z forward, x right
         if (c.z() <= 0 || std::abs(std::atan2(c.x(), c.z())) > o.camera_half_fov_rad) continue;
       }
+      bool unlabelled = false;
+      for (const Box& b : kf.dontcare) unlabelled = unlabelled || b.contains(p);
+      if (unlabelled) continue;
       bool dynamic = false, band = false;
-      for (const Box* b : boxes)
-        if (b->contains(p)) {
+      const double t = boxes.empty() ? 0.0 : o.sweep.firingTime(p.x(), p.y());
+      for (const MovingBox* m : boxes) {
+        Box b = m->at(t);
+        b.size += Eigen::Vector3d(2 * o.label_tolerance_m, 2 * o.label_tolerance_m, o.label_tolerance_m);
+        b.center.z() += 0.5 * o.label_tolerance_m;
+        if (b.contains(p)) {
           dynamic = true;
-          band = band || p.z() < b->center.z() - 0.5 * b->size.z() + o.bottom_band_m;
+          band = band || p.z() < b.center.z() - 0.5 * b.size.z() + o.bottom_band_m;
         }
+      }
       if (band) continue;
       auto& v = votes[voxelKey(kf.T_map_lidar * p, o.voxel_m)];
       (dynamic ? v.second : v.first) += 1;

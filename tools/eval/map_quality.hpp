@@ -3,7 +3,8 @@
 // counted on a voxel grid: the points of the keyframe scans the map was built from, placed with
 // the map's own keyframe poses, are labelled dynamic (inside the labelled box of an object whose
 // labelled track moves) or static (everything else); a voxel takes the label of the majority of
-// its points. SA is the share of static voxels the map keeps, DA the share of dynamic voxels it
+// its points. A point is tested against the box where the object was when the lidar fired at it
+// (sweep_timing.hpp): the labels are for the instant the sweep faces ahead, the points are not. SA is the share of static voxels the map keeps, DA the share of dynamic voxels it
 // does not hold, AA = sqrt(SA x DA).
 #pragma once
 
@@ -13,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "dlslot/sweep_timing.hpp"
 #include "dlslot/types.hpp"
 
 namespace dlslot::eval {
@@ -25,10 +27,17 @@ struct MapTruthOptions {
   double moving_span_m = 1.0;
   // The lowest band of a box is where its wheels meet the road: neither static nor dynamic, not scored.
   double bottom_band_m = 0.1;
+  // A labelled box is tight on the object's surface, so sensor noise puts about half of the points
+  // on its faces outside it: a point within this much outside a moving object's box (sides and
+  // top; below it is the road) is the object's. 0.1 m: 3 sigma of the range noise at 30 m (2 cm +
+  // 2 cm per 100 m, with the footprint term at 60 deg incidence) plus the beams' angle residuals.
+  double label_tolerance_m = 0.1;
   // Real KITTI labels cover what the camera sees: score only points in front of the camera within
   // its horizontal field of view (set from the calibration; empty = all around, the simulator's labels).
   std::optional<Pose> T_cam_lidar;
   double camera_half_fov_rad = 0.0;
+  // The scans' firing order (period 0: de-skewed scans, every point tested against the t = 0 box).
+  SweepTiming sweep;
 };
 
 // One keyframe: its scan (lidar frame), its pose in the map, the labelled boxes of its scan.
@@ -36,8 +45,17 @@ struct MapKeyframe {
   int frame = 0;
   PointCloud scan;
   Pose T_map_lidar = Pose::Identity();
-  std::vector<Box> labels;  // lidar frame, id = labelled track id
+  // Lidar frame, box.id = labelled track id, with the box's motion relative to the lidar (from the
+  // labels of the scans before and after; zero when the track is seen in one scan only).
+  std::vector<MovingBox> labels;
+  // DontCare boxes (lidar frame): objects too thinly seen to be labelled; their points are not
+  // scored (KITTI's protocol for DontCare), whether the object moves is unknown.
+  std::vector<Box> dontcare;
 };
+
+// The labels of scan `frame` with their motion relative to the lidar, from the same tracks' labels
+// in the neighbouring scans (dt seconds apart; the central difference where both exist).
+std::vector<MovingBox> movingLabels(const std::map<int, std::vector<Box>>& labels_by_frame, int frame, double dt);
 
 struct MapScore {
   double voxel_m = 0;

@@ -78,6 +78,12 @@ TEST(MapTruth, LabelsMoveWithTheirTrackBetweenScans) {
   EXPECT_NEAR(sweep.firingTime(0.0, 1.0), -0.025, 1e-12);
   EXPECT_NEAR(sweep.firingTime(-1.0, -1e-9), 0.05, 1e-6);
   EXPECT_NEAR(sweep.firingTime(1.0, 0.0), 0.0, 1e-12);
+  // Its azimuth is atan2's, all around.
+  for (int k = 0; k < 3600; ++k) {
+    const double a = -M_PI + 2 * M_PI * k / 3600.0, r = 0.5 + k % 7;
+    ASSERT_NEAR(SweepTiming::azimuth(r * std::cos(a), r * std::sin(a)), std::atan2(r * std::sin(a), r * std::cos(a)), 2.1e-4) << a;
+  }
+  EXPECT_EQ(SweepTiming::azimuth(0.0, 0.0), 0.0);
 }
 
 TEST(MapTruth, AMapWithoutThePassingCarScoresOneOnBothCounts) {

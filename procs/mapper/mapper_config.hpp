@@ -31,7 +31,7 @@ struct MapperConfig {
   double min_range_m = 2.5, max_range_m = 50.0;
   double map_voxel_m = 0.2;
   bool remove_movable = false;  // remove: movable (every track) instead of dynamic (moving tracks)
-  double box_margin_m = 0.3;
+  double box_margin_m = 0.7;
   double ground_clearance_m = 0.1;
   // The scans' firing order: a moving object's points lie in its box moved by its motion relative to
   // the lidar until the instant they were fired (sweep_timing.hpp); period 0: de-skewed scans.

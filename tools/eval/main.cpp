@@ -304,7 +304,16 @@ void addMap(const Options& o, const DataSet& data, RunData& run) {
   if (!o.kitti_root.empty()) {
     const kitti::SequenceReader reader(o.kitti_root, o.sequence, {}, -1e300, o.frame_period);
     if (reader.hasScans() && reader.hasLabels()) {
-      if (!reader.paths().poses_are_lidar) {
+      std::map<int, std::vector<Box>> labels;
+      for (int f = 0; f < reader.size(); ++f) labels[f] = reader.read(f).labels;
+      // Real KITTI labels cover what camera 2 sees; the simulator labels all around. Told apart by the
+      // labels themselves (the layout does not tell: both are tracking folders): a label behind the
+      // camera exists only where the labelling is all around.
+      bool all_around = false;
+      const Pose T_cam_lidar = reader.calib().T_rect_velo();
+      for (const auto& [f, boxes] : labels)
+        for (const Box& b : boxes) all_around = all_around || (T_cam_lidar * b.center).z() < 0;
+      if (!all_around) {
         // Real KITTI labels: only what camera 2 sees (its horizontal field of view from P2).
         const kitti::Calib& calib = reader.calib();
         opt.T_cam_lidar = calib.T_rect_velo();
@@ -312,8 +321,6 @@ void addMap(const Options& o, const DataSet& data, RunData& run) {
         opt.camera_half_fov_rad = fx > 0 ? std::atan(0.5 * kitti::ImageSize().width / fx) : 0.0;
       }
       std::vector<MapKeyframe> keyframes;
-      std::map<int, std::vector<Box>> labels;
-      for (int f = 0; f < reader.size(); ++f) labels[f] = reader.read(f).labels;
       for (const auto& r : keyframe_rows) {
         MapKeyframe k;
         k.frame = static_cast<int>(r[0]);

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 
 #include "dlslot/types.hpp"
@@ -26,8 +27,19 @@ struct SweepTiming {
   // Seconds from the reference instant (facing ahead) to the firing of a point at lidar-frame (x, y).
   double firingTime(double x, double y) const {
     if (period_s <= 0) return 0.0;
-    const double a = std::atan2(y, x);  // (-pi, pi], 0 ahead, positive to the left
+    const double a = azimuth(x, y);  // [-pi, pi], 0 ahead, positive to the left
     return (clockwise ? -a : a) / (2.0 * M_PI) * period_s;
+  }
+  // atan2(y, x) within 2.1e-4 rad (3 microseconds of a 0.1 s sweep: 0.2 mm at 50 m/s) at a fraction of its
+  // cost: every point near a moving box asks for it (a minimax polynomial on [0, 1], folded).
+  static double azimuth(double x, double y) {
+    const double ax = std::abs(x), ay = std::abs(y), hi = std::max(ax, ay);
+    if (hi == 0) return 0.0;
+    const double a = std::min(ax, ay) / hi, s = a * a;
+    double r = ((-0.0464964749 * s + 0.15931422) * s - 0.327622764) * s * a + a;
+    if (ay > ax) r = M_PI / 2 - r;
+    if (x < 0) r = M_PI - r;
+    return y < 0 ? -r : r;
   }
   double maxOffset() const { return 0.5 * period_s; }
 };

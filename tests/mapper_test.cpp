@@ -23,6 +23,7 @@
 #include "mapper/scan_context.hpp"
 #include "mapper/track_boxes.hpp"
 #include "mapper/voxel_map.hpp"
+#include "dlslot/cpu_clock.hpp"
 #include "dlslot/voxel_key.hpp"
 
 using namespace dlslot;
@@ -508,6 +509,43 @@ TEST(IdleWorker, RunsJobsInOrderBoundsItsQueueAndKeepsWhatAJobThrew) {
   ASSERT_EQ(errors.size(), 1u);
   EXPECT_NE(errors[0].find("boom"), std::string::npos);
   EXPECT_TRUE(worker.priorityError().empty()) << worker.priorityError();
+}
+
+// Burns `ms` of this thread's CPU time (not wall time: the machine may be shared).
+static void burnCpuMs(double ms) {
+  const double start = threadCpuMs();
+  while (threadCpuMs() - start < ms) {
+  }
+}
+
+TEST(IdleWorker, HeldToAShareOfACoreUntilDrainLiftsTheLimit) {
+  using Clock = std::chrono::steady_clock;
+  {
+    IdleWorker worker("test", true, 8, /*idle_priority=*/false, /*cpu_share=*/0.2);
+    std::atomic<int> done{0};
+    const auto start = Clock::now();
+    for (int i = 0; i < 3; ++i) worker.post([&] {
+      burnCpuMs(20);
+      ++done;
+    });
+    while (done < 3) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    const double wall_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    // Each job rests 4x its CPU time before the next starts: at most a fifth of a core.
+    EXPECT_GE(wall_ms, 3 * 20 + 2 * 80) << "the jobs ran back to back";
+  }
+  // A rest of ~20 s (a share of 0.001 after 20 ms of work) ends when drain() is called.
+  IdleWorker worker("test", true, 8, false, 0.001);
+  std::atomic<bool> ran{false};
+  worker.post([&] {
+    burnCpuMs(20);
+    ran = true;
+  });
+  while (!ran) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  const auto start = Clock::now();
+  worker.drain();
+  EXPECT_LT(std::chrono::duration<double>(Clock::now() - start).count(), 5.0) << "drain() waited out the rest";
+  EXPECT_THROW(IdleWorker("test", true, 1, false, 0.0), std::invalid_argument);
+  EXPECT_THROW(IdleWorker("test", true, 1, false, 1.5), std::invalid_argument);
 }
 
 TEST(IdleWorker, InlineRunsEachJobInPost) {

@@ -5,14 +5,19 @@
 #include <time.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <stdexcept>
 
+#include "dlslot/cpu_clock.hpp"
+
 namespace dlslot::mapper {
 
-IdleWorker::IdleWorker(std::string name, bool threaded, size_t capacity, bool idle_priority)
-    : name_(std::move(name)), threaded_(threaded), capacity_(capacity) {
+IdleWorker::IdleWorker(std::string name, bool threaded, size_t capacity, bool idle_priority, double cpu_share)
+    : name_(std::move(name)), threaded_(threaded), capacity_(capacity), cpu_share_(cpu_share) {
   if (capacity_ < 1) throw std::invalid_argument(name_ + ": the queue's capacity must be >= 1");
+  if (!(cpu_share_ > 0 && cpu_share_ <= 1))
+    throw std::invalid_argument(name_ + ": the share of a core must be in (0, 1], got " + std::to_string(cpu_share_));
   if (!threaded_) return;
   thread_ = std::thread([this] { work(); });
   if (idle_priority) setPriority(true);
@@ -23,7 +28,7 @@ IdleWorker::~IdleWorker() {
   setPriority(false);  // what is left runs at normal priority: the process is ending
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    stop_ = true;
+    stop_ = unlimited_ = true;
   }
   wake_.notify_all();
   if (thread_.joinable()) thread_.join();
@@ -59,6 +64,8 @@ void IdleWorker::drain() {
   if (!threaded_) return;
   setPriority(false);
   std::unique_lock<std::mutex> lock(mutex_);
+  unlimited_ = true;
+  wake_.notify_all();  // ends a rest
   idle_.wait(lock, [this] { return queue_.empty() && !busy_; });
 }
 
@@ -106,6 +113,7 @@ void IdleWorker::work() {
       busy_ = true;
     }
     space_.notify_all();
+    const double start = threadCpuMs();
     try {
       job();
     } catch (const std::exception& e) {
@@ -113,7 +121,11 @@ void IdleWorker::work() {
       errors_.push_back(name_ + ": " + e.what());
     }
     {
-      std::lock_guard<std::mutex> lock(mutex_);
+      std::unique_lock<std::mutex> lock(mutex_);
+      if (cpu_share_ < 1 && !unlimited_) {
+        const double rest_ms = (threadCpuMs() - start) * (1 / cpu_share_ - 1);
+        wake_.wait_for(lock, std::chrono::duration<double, std::milli>(rest_ms), [this] { return unlimited_; });
+      }
       busy_ = false;
     }
     idle_.notify_all();

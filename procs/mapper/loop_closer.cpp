@@ -35,8 +35,8 @@ PointCloud voxelDownsample(const PointCloud& points, double voxel_m) {
   return out;
 }
 
-LoopCloser::LoopCloser(const LoopConfig& config, bool threaded, size_t capacity, bool idle_priority)
-    : config_(config), worker_("loop closure", threaded, capacity, idle_priority) {
+LoopCloser::LoopCloser(const LoopConfig& config, bool threaded, size_t capacity, bool idle_priority, double cpu_share)
+    : config_(config), worker_("loop closure", threaded, capacity, idle_priority, cpu_share) {
   sc_params_.rings = config.rings;
   sc_params_.sectors = config.sectors;
   sc_params_.max_radius_m = config.max_radius_m;

@@ -39,7 +39,8 @@ class LoopCloser {
   // threaded: verification on a worker thread (live; idle_priority: at SCHED_IDLE, idle_worker.hpp)
   // with at most `capacity` keyframes waiting (add() blocks beyond); else inline in add()
   // (offline, reproducible).
-  LoopCloser(const LoopConfig& config, bool threaded, size_t capacity = 64, bool idle_priority = false);
+  LoopCloser(const LoopConfig& config, bool threaded, size_t capacity = 64, bool idle_priority = false,
+             double cpu_share = 1.0);
   ~LoopCloser();
   LoopCloser(const LoopCloser&) = delete;
   LoopCloser& operator=(const LoopCloser&) = delete;

@@ -14,13 +14,13 @@ Mapper::Mapper(const MapperConfig& config, bool threaded)
       map_(config.map_voxel_m),
       removed_(config.map_voxel_m),
       loops_(std::make_unique<LoopCloser>(config.loop, threaded, static_cast<size_t>(config.max_backlog_keyframes),
-                                          config.idle_priority)),
+                                          config.idle_priority, config.live_cpu_share)),
       // Every keyframe admitted while the backlog was below the bound must fit without blocking the
       // caller: those still in their decision delay (one per scan at most) come on top of the bound.
       committer_(std::make_unique<IdleWorker>(
           "keyframes", threaded,
           static_cast<size_t>(config.max_backlog_keyframes) + static_cast<size_t>(config.decision_delay_frames) + 2,
-          config.idle_priority)) {}
+          config.idle_priority, config.live_cpu_share)) {}
 
 Mapper::~Mapper() {
   // The keyframe thread uses the loop closer: it stops first.

@@ -35,6 +35,10 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
   s.get("join_timeout_s", c.join_timeout_s);
   s.get("max_backlog_keyframes", c.max_backlog_keyframes);
   s.get("idle_priority", c.idle_priority);
+  s.get("live_cpu_share", c.live_cpu_share);
+  if (!(c.live_cpu_share > 0 && c.live_cpu_share <= 1))
+    throw ConfigError(s.file() + ": " + s.path() + ".live_cpu_share: expected a share of one core in (0, 1], got " +
+                      std::to_string(c.live_cpu_share));
   if (c.max_backlog_keyframes < 1)
     throw ConfigError(s.file() + ": " + s.path() + ".max_backlog_keyframes: expected >= 1, got " +
                       std::to_string(c.max_backlog_keyframes));

@@ -41,6 +41,7 @@ struct MapperConfig {
   double join_timeout_s = 5.0;  // live: how long a scan waits for its SLOT_STATE (and back)
   int max_backlog_keyframes = 50;  // live: keyframes that may wait for the keyframe thread (and for loop closure)
   bool idle_priority = true;       // live: the keyframe and loop-closure threads at SCHED_IDLE
+  double live_cpu_share = 1.0;     // live: the most of one core each of those threads uses (idle_worker.hpp)
   LoopConfig loop;
 
   // Reads and checks the section; throws ConfigError naming the key and what was expected.

@@ -2,9 +2,11 @@
 # `cmake --install` into a temporary prefix, then a short simulated pipeline run by the installed
 # dlslot-run from a directory outside the source and build trees: the installed programs must find
 # each other, the installed config and the installed scenarios (not the source tree's).
-#   tests/install_test.sh BUILD_DIR     (run inside scripts/netns-run: the run talks LCM)
+#   tests/install_test.sh BUILD_DIR [--slow]     (run inside scripts/netns-run: the run talks LCM)
+# --slow (sanitizer builds): the installed config's lockstep wait is made ten times longer.
 set -euo pipefail
-build=${1:?usage: install_test.sh BUILD_DIR}
+build=${1:?usage: install_test.sh BUILD_DIR [--slow]}
+slow=${2:-}
 prefix=$(mktemp -d /tmp/dlslot-install.XXXXXX)
 trap 'rm -rf "$prefix"' EXIT
 fail() { echo "install test: $*" >&2; [[ -f $prefix/run.log ]] && tail -30 "$prefix/run.log" >&2; exit 1; }
@@ -17,6 +19,10 @@ done
 [[ -f $prefix/share/dlslot/config/dlslot.yaml ]] || fail "share/dlslot/config/dlslot.yaml was not installed"
 [[ -f $prefix/share/dlslot/config/scenarios/intersection.yaml ]] || fail "the scenarios were not installed"
 [[ -e $prefix/bin/intersection_test ]] && fail "a test binary was installed"
+if [[ $slow == --slow ]]; then
+  sed -i 's/lockstep_timeout_s: 5.0/lockstep_timeout_s: 50.0/' "$prefix/share/dlslot/config/dlslot.yaml"
+  grep -q "lockstep_timeout_s: 50.0" "$prefix/share/dlslot/config/dlslot.yaml" || fail "no lockstep_timeout_s: 5.0 to lengthen"
+fi
 
 cd "$prefix"
 "$prefix/bin/dlslot-run" --scenario intersection --frames 20 --out "$prefix/run" --no-render > "$prefix/run.log" 2>&1 \

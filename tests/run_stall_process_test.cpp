@@ -3,6 +3,8 @@
 // stalled once its heartbeat (PROCESS_STATUS, 1 Hz) has been missing for --heartbeat-timeout
 // seconds, exit 3, and leave nothing running.
 #include <gtest/gtest.h>
+#include <fstream>
+#include <sstream>
 #include <signal.h>
 
 #include <filesystem>
@@ -25,13 +27,14 @@ pid_t childNamed(pid_t parent, const std::string& comm) {
 }
 
 // `frames` of the intersection simulated into OUT/data; dlslot-run's arguments for them (into
-// OUT/run, no renderer, no evaluation) with `extra`.
-std::vector<std::string> runOnSimulated(const std::string& out, int frames, const std::vector<std::string>& extra) {
+// OUT/run, no renderer, no evaluation) with `extra`, under the config file `cfg`.
+std::vector<std::string> runOnSimulated(const std::string& out, int frames, const std::vector<std::string>& extra,
+                                        const std::string& cfg = config()) {
   ChildProcess sim({bin("dlslot-sim"), "--scenario", "intersection", "--frames", std::to_string(frames), "--seed", "3",
                     "--out", out + "/data"},
                    out + "/sim.log");
   EXPECT_EQ(sim.wait(300), 0) << sim.output();
-  std::vector<std::string> a = {bin("dlslot-run"), "--config", config(), "--kitti", out + "/data", "--detections",
+  std::vector<std::string> a = {bin("dlslot-run"), "--config", cfg, "--kitti", out + "/data", "--detections",
                                 out + "/data/detections/sim", "--out", out + "/run", "--quiet", "--no-render",
                                 "--no-eval"};
   a.insert(a.end(), extra.begin(), extra.end());
@@ -80,12 +83,24 @@ TEST(RunStallProcess, StoppedOdometryIsReportedByName) {
 // In lockstep a process that is only slow (a loaded machine, a sanitizer build) changes nothing:
 // no later frame comes before this one is solved, so the backend and the tracker wait for its
 // input as long as the player's lockstep timeout allows (0.4 of it each) instead of going on
-// without it. The odometry is stopped for 1.5 s, longer than the backend's own live wait
-// (backend.join_timeout_s, 1 s), shorter than the lockstep's (0.4 x 5 s).
+// without it; the mapper holds a scan as long as the player may wait for the SLOT_STATEs before
+// it. The odometry is stopped for 1.5 s, longer than the backend's own live wait
+// (backend.join_timeout_s, 1 s) and the mapper's (set to 1 s here), shorter than the lockstep's
+// (0.4 x 5 s).
 TEST(RunStallProcess, SlowOdometryInLockstepLosesNothing) {
   ASSERT_TRUE(insidePrivateNetwork());
   const std::string out = scratchDir();
-  ChildProcess run(runOnSimulated(out, 60, {"--no-map"}), out + "/run.log");
+  std::ifstream in(config());
+  std::stringstream shipped;
+  shipped << in.rdbuf();
+  std::string yaml = shipped.str();
+  const std::string key = "join_timeout_s: 5.0         # live: how long a scan waits for its SLOT_STATE";
+  const size_t at = yaml.find(key);
+  ASSERT_NE(at, std::string::npos) << "the mapper's join_timeout_s line changed in the shipped config";
+  yaml.replace(at, std::string("join_timeout_s: 5.0").size(), "join_timeout_s: 1.0");
+  const std::string cfg = out + "/short-mapper-wait.yaml";
+  std::ofstream(cfg) << yaml;
+  ChildProcess run(runOnSimulated(out, 60, {}, cfg), out + "/run.log");
   const pid_t odometry = odometryMidRun(run, out);
   ASSERT_GT(odometry, 0) << run.output();
   ASSERT_EQ(kill(odometry, SIGSTOP), 0);

@@ -60,12 +60,18 @@ void IdleWorker::post(std::function<void()> job) {
   wake_.notify_one();
 }
 
-void IdleWorker::drain() {
+void IdleWorker::liftLimits() {
   if (!threaded_) return;
   setPriority(false);
-  std::unique_lock<std::mutex> lock(mutex_);
+  std::lock_guard<std::mutex> lock(mutex_);
   unlimited_ = true;
   wake_.notify_all();  // ends a rest
+}
+
+void IdleWorker::drain() {
+  if (!threaded_) return;
+  liftLimits();
+  std::unique_lock<std::mutex> lock(mutex_);
   idle_.wait(lock, [this] { return queue_.empty() && !busy_; });
 }
 

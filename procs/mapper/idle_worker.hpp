@@ -35,7 +35,9 @@ class IdleWorker {
 
   // Queues `job` (runs it now when inline); blocks while the queue is full.
   void post(std::function<void()> job);
-  // Back to normal priority and no share limit, then waits until every job posted so far has run.
+  // Back to normal priority and no share limit (for the rest of the worker's life).
+  void liftLimits();
+  // liftLimits(), then waits until every job posted so far has run.
   void drain();
   // Jobs waiting (not counting the one running), and the most that ever waited.
   size_t backlog() const;

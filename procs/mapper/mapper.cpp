@@ -97,6 +97,8 @@ void Mapper::finish() {
     auto boxes = std::make_shared<std::vector<MovingBox>>(lidarBoxes(*job));
     committer_->post([this, job, boxes] { commit(*job, *boxes); });
   }
+  // The keyframe thread's catch-up feeds the loop thread: both at full speed from here.
+  loops_->worker().liftLimits();
   committer_->drain();
   loops_->drain();
   applyLoopResult();

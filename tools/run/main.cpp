@@ -370,22 +370,22 @@ int runPipeline(int argc, char** argv) {
     if (speed > 0) render_args.push_back("--skip-when-behind");
     sup.start("renderer", args(bin + "/dlslot-renderer", render_args), logs + "/renderer.log");
   }
-  if (!no_map) {
-    // The mapper is not on the lockstep path (the player waits for SLOT_STATE only); it writes
-    // the map files into the run folder when it is stopped.
-    pipeline.insert(pipeline.begin(), "mapper");
-    sup.start("mapper", args(bin + "/dlslot-mapper", {"--out", out}), logs + "/mapper.log");
-  }
+  // The mapper is not on the lockstep path (the player waits for SLOT_STATE only); it writes the
+  // map files into the run folder when it is stopped. It starts below, with its wait.
+  if (!no_map) pipeline.insert(pipeline.begin(), "mapper");
   // In lockstep no later frame comes before this one is solved, so the tracker and the backend may
   // wait for a frame's inputs as long as the player waits for its SLOT_STATE: going on without an
   // input that is merely slow (a loaded machine, a sanitizer build) would change the results. Their
   // two waits can come one after the other (the tracker's for ODOMETRY, then the backend's for
-  // ASSOCIATIONS), and both must end before the player's: 0.4 of it each.
-  std::vector<std::string> join;
+  // ASSOCIATIONS), and both must end before the player's: 0.4 of it each. The mapper holds a scan
+  // until its SLOT_STATE, which comes after the player's waits for the frames in flight before it.
+  std::vector<std::string> join, mapper_args = {"--out", out};
   if (!(speed > 0)) {
     const double player_wait = YAML::LoadFile(config)["player"]["lockstep_timeout_s"].as<double>(5.0);
     join = {"--join-timeout", std::to_string(0.4 * player_wait)};
+    mapper_args.insert(mapper_args.end(), {"--join-timeout", std::to_string((in_flight + 1) * player_wait)});
   }
+  if (!no_map) sup.start("mapper", args(bin + "/dlslot-mapper", mapper_args), logs + "/mapper.log");
   std::vector<std::string> backend_args = {"--mode", ms.backend};
   backend_args.insert(backend_args.end(), join.begin(), join.end());
   sup.start("backend", args(bin + "/dlslot-backend", backend_args), logs + "/backend.log");

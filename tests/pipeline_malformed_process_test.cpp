@@ -23,8 +23,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr int kFrames = 16;
-constexpr int kInjectAt = 6;     // the bad messages follow the real ones of this frame
+// The bad messages follow the real ones of frame kInjectAt; the frames after it keep the player
+// playing while they arrive (a 16-frame run could end before the player read them, on a machine
+// with nothing else to do).
+constexpr int kFrames = 40;
+constexpr int kInjectAt = 6;
 constexpr int kOldFrame = 4;     // re-sent as the out-of-order case
 
 std::vector<Malformed> operator+(std::vector<Malformed> a, const std::vector<Malformed>& b) {

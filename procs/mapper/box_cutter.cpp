@@ -5,18 +5,6 @@
 #include <stdexcept>
 
 namespace dlslot::mapper {
-namespace {
-
-std::vector<MovingBox> still(const std::vector<Box>& boxes) {
-  std::vector<MovingBox> out;
-  out.reserve(boxes.size());
-  for (const Box& b : boxes) out.push_back({b});
-  return out;
-}
-
-}  // namespace
-
-BoxCutter::BoxCutter(const std::vector<Box>& boxes, double reach_m) : BoxCutter(still(boxes), reach_m) {}
 
 BoxCutter::BoxCutter(const std::vector<MovingBox>& boxes, double reach_m, const SweepTiming& sweep)
     : sweep_(sweep), reach_(static_cast<float>(reach_m)), inverse_cell_(1.0f / kCellM) {

@@ -23,16 +23,12 @@ class BoxCutter {
   // the grid covers |x|, |y| <= reach_m (points beyond are tested against every box, so the answer
   // never depends on the grid).
   BoxCutter(const std::vector<MovingBox>& boxes, double reach_m, const SweepTiming& sweep = {0.0, true});
-  // Boxes that do not move relative to the lidar (or a de-skewed scan).
-  BoxCutter(const std::vector<Box>& boxes, double reach_m);
-  // The box p lies inside at p's firing time (MovingBox::at, no margin), or -1.
-  int boxOf(const Eigen::Vector3f& p) const {
+  // True when p lies inside one of the boxes at p's firing time (MovingBox::at, no margin).
+  bool inside(const Eigen::Vector3f& p) const {
     const int cell = cellOf(p.x(), p.y());
     if (cell < 0) return insideAny(p, 0, static_cast<int>(cuts_.size()), nullptr);
-    if (start_[cell] == start_[cell + 1]) return -1;
     return insideAny(p, start_[cell], start_[cell + 1], order_.data());
   }
-  bool inside(const Eigen::Vector3f& p) const { return boxOf(p) >= 0; }
   size_t boxes() const { return cuts_.size(); }
 
  private:
@@ -45,21 +41,21 @@ class BoxCutter {
     if (x < -reach_ || y < -reach_ || ix >= side_ || iy >= side_) return -1;
     return iy * side_ + ix;
   }
-  // The first of the cuts [begin, end) of `order` (or of cuts_ when order is null) holding p.
-  int insideAny(const Eigen::Vector3f& p, int begin, int end, const uint16_t* order) const {
-    if (begin >= end) return -1;
+  // The cuts [begin, end) of `order` (or of cuts_ when order is null); the firing time is computed
+  // only when some box is to be tested.
+  bool insideAny(const Eigen::Vector3f& p, int begin, int end, const uint16_t* order) const {
+    if (begin >= end) return false;
     const float t = static_cast<float>(sweep_.firingTime(p.x(), p.y()));
     for (int k = begin; k < end; ++k) {
-      const int index = order ? order[k] : k;
-      const Cut& b = cuts_[index];
+      const Cut& b = cuts_[order ? order[k] : k];
       const Eigen::Vector3f d = p - (b.center + t * b.velocity);
       // The heading at t to first order (|yaw_rate t| is a few hundredths of a radian).
       const float dy = t * b.yaw_rate, c = b.c - b.s * dy, s = b.s + b.c * dy;
       if (std::abs(c * d.x() + s * d.y()) <= b.half.x() && std::abs(-s * d.x() + c * d.y()) <= b.half.y() &&
           std::abs(d.z()) <= b.half.z())
-        return index;
+        return true;
     }
-    return -1;
+    return false;
   }
 
   static constexpr float kCellM = 2.0f;  // about half a car: a box reaches few cells, a cell holds few boxes

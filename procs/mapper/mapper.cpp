@@ -69,23 +69,21 @@ std::vector<MovingBox> Mapper::lidarBoxes(const Pending& p) const {
     for (const Box& b : boxes_.removalBoxes(frame, utime * 1e-6)) out[b.id] = b.transformed(lidar_from_world);
     return out;
   };
-  const std::map<int, Box> here = inLidar(p.frame, p.utime, p.pose);
-  std::optional<std::pair<int64_t, std::map<int, Box>>> before, after;
-  if (const auto it = frames_.find(p.frame - 1); it != frames_.end())
-    before.emplace(it->second.first, inLidar(it->first, it->second.first, it->second.second));
-  if (const auto it = frames_.find(p.frame + 1); it != frames_.end())
-    after.emplace(it->second.first, inLidar(it->first, it->second.first, it->second.second));
+  // A neighbouring scan's time and boxes (none when that scan is not held).
+  const auto neighbour = [&](int frame) -> std::pair<int64_t, std::map<int, Box>> {
+    const auto it = frames_.find(frame);
+    if (it == frames_.end()) return {p.utime, {}};
+    return {it->second.first, inLidar(frame, it->second.first, it->second.second)};
+  };
+  const auto [t_before, before] = neighbour(p.frame - 1);
+  const auto [t_after, after] = neighbour(p.frame + 1);
   std::vector<MovingBox> out;
-  out.reserve(here.size());
-  for (const auto& [id, b] : here) {
-    const Box* a = nullptr;
-    const Box* c = nullptr;
-    int64_t ta = p.utime, tc = p.utime;
-    if (before)
-      if (const auto it = before->second.find(id); it != before->second.end()) a = &it->second, ta = before->first;
-    if (after)
-      if (const auto it = after->second.find(id); it != after->second.end()) c = &it->second, tc = after->first;
-    out.push_back(movingBox(b, a ? *a : b, c ? *c : b, (tc - ta) * 1e-6));
+  for (const auto& [id, b] : inLidar(p.frame, p.utime, p.pose)) {
+    // Seen in only one of the neighbours: the motion over that half; in neither: still.
+    const auto a = before.find(id), c = after.find(id);
+    const bool has_a = a != before.end(), has_c = c != after.end();
+    out.push_back(movingBox(b, has_a ? a->second : b, has_c ? c->second : b,
+                            ((has_c ? t_after : p.utime) - (has_a ? t_before : p.utime)) * 1e-6));
   }
   return out;
 }

@@ -130,6 +130,18 @@ void NodeOptions::addTo(CommandLine& cl) {
   cl.action("--insecure", [](const std::string&) { useNoKey(); }, "no message authentication (open LCM)", false);
 }
 
+void JoinTimeoutOption::addTo(CommandLine& cl, const std::string& what) {
+  cl.option("--join-timeout", &seconds,
+            "seconds to wait for " + what + "; dlslot-run lengthens it in lockstep, where no later frame comes before "
+            "this one is solved");
+}
+
+double JoinTimeoutOption::resolve(double configured_s) const {
+  if (std::isnan(seconds)) return configured_s;
+  if (!(seconds > 0)) throw std::invalid_argument("--join-timeout: expected a time > 0 (s)");
+  return seconds;
+}
+
 void useKeyFile(const std::string& path) {
   if (path.empty()) throw std::invalid_argument("--key: expected a key file");
   const std::string abs = std::filesystem::absolute(path).string();

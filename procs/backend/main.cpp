@@ -325,7 +325,7 @@ int main(int argc, char** argv) {
   return runMain("dlslot-backend", [&] {
     NodeOptions opts;
     std::string mode, offline_in, offline_out, ego_truth;
-    double join_timeout_override = std::numeric_limits<double>::quiet_NaN();  // NaN: not given
+    JoinTimeoutOption join_timeout;
     CommandLine cl("dlslot-backend",
                    "Sliding-window optimization of ego poses, landmarks and objects (DL-SLOT III-C): "
                    "ODOMETRY + ASSOCIATIONS -> SLOT_STATE.");
@@ -337,9 +337,7 @@ int main(int argc, char** argv) {
     cl.option("--ego-truth", &ego_truth,
               "with --offline: replace the odometry by these true T_world_lidar poses (KITTI 3x4 lines, e.g. a "
               "simulated sequence's training/poses/0000.txt): the objects' accuracy with a perfect ego");
-    cl.option("--join-timeout", &join_timeout_override,
-              "seconds to wait for a frame's other input (overrides backend.join_timeout_s); dlslot-run gives "
-              "the player's lockstep timeout in lockstep, where no later frame comes before this one is solved");
+    join_timeout.addTo(cl, "a frame's other input (overrides backend.join_timeout_s)");
     if (!cl.parse(argc, argv)) return 0;
     if (!offline_out.empty() && offline_in.empty()) throw std::invalid_argument("--out needs --offline");
     if (!ego_truth.empty() && offline_in.empty()) throw std::invalid_argument("--ego-truth needs --offline");
@@ -352,11 +350,7 @@ int main(int argc, char** argv) {
     section.get("join_timeout_s", join_timeout_s);
     if (!(join_timeout_s > 0)) throw ConfigError(opts.config + ": backend.join_timeout_s: expected a time > 0 (s)");
     section.finish();
-    if (!std::isnan(join_timeout_override)) {
-      if (!(join_timeout_override > 0))
-        throw std::invalid_argument("--join-timeout: expected a time > 0 (s)");
-      join_timeout_s = join_timeout_override;
-    }
+    join_timeout_s = join_timeout.resolve(join_timeout_s);
     if (!mode.empty()) config.mode = parseMode(mode);
     if (opts.check_config) return 0;
     retainFreedMemory();

@@ -5,13 +5,11 @@
 #include <sys/resource.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstring>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <limits>
 #include <numeric>
 
 #include "dlslot/convert.hpp"
@@ -251,10 +249,8 @@ int main(int argc, char** argv) {
     cl.option("--out", &out, "directory for the map files (written on exit; required with --offline)");
     cl.option("--remove", &remove, "dynamic (moving tracks) | movable (every track, parked vehicles too); overrides mapper.remove");
     cl.flag("--no-loops", &no_loops, "no loop closure (the map and trajectory follow SLOT_STATE)");
-    double join_timeout = std::numeric_limits<double>::quiet_NaN();  // NaN: not given
-    cl.option("--join-timeout", &join_timeout,
-              "live: seconds a scan waits for its SLOT_STATE (overrides mapper.join_timeout_s); dlslot-run gives "
-              "(frames in flight + 1) x player.lockstep_timeout_s in lockstep");
+    JoinTimeoutOption join_timeout;
+    join_timeout.addTo(cl, "a scan's SLOT_STATE, live (overrides mapper.join_timeout_s)");
     if (!cl.parse(argc, argv)) return 0;
     if (!offline_in.empty() && out.empty()) throw std::invalid_argument("--offline needs --out DIR");
     if (!remove.empty() && remove != "dynamic" && remove != "movable")
@@ -266,10 +262,7 @@ int main(int argc, char** argv) {
     section.finish();
     if (!remove.empty()) config.remove_movable = remove == "movable";
     if (no_loops) config.loop.enabled = false;
-    if (!std::isnan(join_timeout)) {
-      if (!(join_timeout > 0)) throw std::invalid_argument("--join-timeout: expected a time > 0 (s)");
-      config.join_timeout_s = join_timeout;
-    }
+    config.join_timeout_s = join_timeout.resolve(config.join_timeout_s);
     if (opts.check_config) return 0;
     if (!offline_in.empty()) return runOffline(config, channels, offline_in, out);
     return runLive(config, channels, opts, out);

@@ -158,6 +158,8 @@ int run(int argc, char** argv) {
   cl.option("--out", &offline.out, "offline: trajectory file to write");
   cl.flag("--quiet", &offline.quiet, "offline: no progress line");
   node_opts.addTo(cl);
+  JoinTimeoutOption join_timeout;
+  join_timeout.addTo(cl, "a scan's DETECTIONS before running unfiltered (overrides odometry.detections_timeout_s)");
   if (!cl.parse(argc, argv)) return 0;
 
   Channels channels;
@@ -179,7 +181,7 @@ int run(int argc, char** argv) {
       throw std::invalid_argument("--offline needs --kitti ROOT, --sequence S and --out FILE");
     return runOffline(offline, cfg);
   }
-  return runNode(node_opts, channels, cfg, timeout_s);
+  return runNode(node_opts, channels, cfg, join_timeout.resolve(timeout_s));
 }
 
 }  // namespace

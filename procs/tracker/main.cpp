@@ -150,19 +150,14 @@ int run(int argc, char** argv) {
   cl.flag("--follow-slot-state", &follow_slot_state,
           "associate a frame only after SLOT_STATE of the frame associated before it (or join_timeout_s): "
           "the same poses as strict lockstep when the player keeps frames in flight (dlslot-player --in-flight)");
-  double join_timeout = std::numeric_limits<double>::quiet_NaN();  // NaN: not given
-  cl.option("--join-timeout", &join_timeout,
-            "seconds to wait for a frame's other input or SLOT_STATE (overrides tracker.join_timeout_s); dlslot-run "
-            "gives the player's lockstep timeout in lockstep, where no later frame comes before this one is solved");
+  JoinTimeoutOption join_timeout;
+  join_timeout.addTo(cl, "a frame's other input or SLOT_STATE (overrides tracker.join_timeout_s)");
   if (!cl.parse(argc, argv)) return 0;
 
   Channels channels;
   ConfigSection root_cfg = loadPipelineConfig(node_opts.config, channels);
   TrackerConfig cfg = TrackerConfig::read(root_cfg.section("tracker"));
-  if (!std::isnan(join_timeout)) {
-    if (!(join_timeout > 0)) throw std::invalid_argument("--join-timeout: expected a time > 0 (s)");
-    cfg.join_timeout_s = join_timeout;
-  }
+  cfg.join_timeout_s = join_timeout.resolve(cfg.join_timeout_s);
   if (node_opts.check_config) return 0;
   if (!off.kitti_root.empty()) return runOffline(off, cfg);
 

@@ -377,7 +377,8 @@ int runPipeline(int argc, char** argv) {
   // wait for a frame's inputs as long as the player waits for its SLOT_STATE: going on without an
   // input that is merely slow (a loaded machine, a sanitizer build) would change the results. Their
   // two waits can come one after the other (the tracker's for ODOMETRY, then the backend's for
-  // ASSOCIATIONS), and both must end before the player's: 0.4 of it each. The mapper holds a scan
+  // ASSOCIATIONS), and both must end before the player's: 0.4 of it each. The odometry's wait for a
+  // scan's DETECTIONS runs alongside the tracker's (both wait for the same message): as long. The mapper holds a scan
   // until its SLOT_STATE, which comes after the player's waits for the frames in flight before it.
   std::vector<std::string> join, mapper_args = {"--out", out};
   if (!(speed > 0)) {
@@ -397,7 +398,9 @@ int runPipeline(int argc, char** argv) {
   std::vector<std::string> tracker_args = join;
   if (!(speed > 0)) tracker_args.push_back("--follow-slot-state");
   sup.start("tracker", args(bin + "/dlslot-tracker", tracker_args), logs + "/tracker.log");
-  sup.start("odometry", args(bin + "/dlslot-odometry", {"--mode", ms.odometry}), logs + "/odometry.log");
+  std::vector<std::string> odometry_args = {"--mode", ms.odometry};
+  odometry_args.insert(odometry_args.end(), join.begin(), join.end());
+  sup.start("odometry", args(bin + "/dlslot-odometry", odometry_args), logs + "/odometry.log");
   if (geometric) {
     pipeline.push_back("detector");
     sup.start("detector", args(bin + "/dlslot-detector", {}), logs + "/detector.log");

@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,17 @@ struct NodeOptions {
   bool check_config = false;
   void addTo(CommandLine& cl);
 };
+// --join-timeout SECONDS for a node that waits for a frame's inputs: it overrides the config's wait.
+// dlslot-run lengthens the waits in lockstep, where no later frame comes before this one is solved,
+// so an input that is merely slow (a loaded machine, a sanitizer build) is not taken for a lost one.
+struct JoinTimeoutOption {
+  double seconds = std::numeric_limits<double>::quiet_NaN();  // NaN: not given
+  // `what`: the wait and the config key it overrides, for --help.
+  void addTo(CommandLine& cl, const std::string& what);
+  // The given value (> 0, else invalid_argument), or `configured_s` when none was given.
+  double resolve(double configured_s) const;
+};
+
 // What --key FILE and --insecure do: point $DLSLOT_KEY_FILE at FILE (checked at once, made
 // absolute), or clear it. Every Node made afterwards uses that key (or none).
 void useKeyFile(const std::string& path);

@@ -63,12 +63,13 @@ TEST(FrameAccounting, LossesAreCountedWhereTheyHappened) {
   EXPECT_NE(v.find("200 solved without odometry"), std::string::npos);
 }
 
-TEST(FrameAccounting, RssStartMiddleEnd) {
+TEST(FrameAccounting, RssStartMiddleThreeQuartersEnd) {
   EXPECT_FALSE(summarizeRss({}).has_value());
-  const auto r = summarizeRss({{0.0, 1024}, {4.0, 2048}, {5.2, 3072}, {10.0, 4096}});
+  const auto r = summarizeRss({{0.0, 1024}, {4.0, 2048}, {5.2, 3072}, {7.0, 5120}, {10.0, 4096}});
   ASSERT_TRUE(r);
   EXPECT_DOUBLE_EQ(r->start_mb, 1.0);
-  EXPECT_DOUBLE_EQ(r->middle_mb, 3.0);  // 5.2 s is nearest the midpoint 5 s
+  EXPECT_DOUBLE_EQ(r->middle_mb, 3.0);          // 5.2 s is nearest the midpoint 5 s
+  EXPECT_DOUBLE_EQ(r->three_quarters_mb, 5.0);  // 7 s is nearest 7.5 s
   EXPECT_DOUBLE_EQ(r->end_mb, 4.0);
   EXPECT_GT(residentKb(), 0);
 }

@@ -125,15 +125,7 @@ TEST(DetectorProcess, ScansInDetectionsOutFaultsCounted) {
 
 TEST(DetectorProcess, BadConfigIsRefused) {
   const std::string dir = scratchDir();
-  const std::string path = dir + "/bad.yaml";
-  {
-    std::ifstream in(config());
-    std::stringstream ss;
-    ss << in.rdbuf();
-    std::string text = ss.str();
-    text.replace(text.find("    sectors: 360"), 16, "    sectors: 2");
-    std::ofstream(path) << text;
-  }
+  const std::string path = configWith(dir, "bad", "    sectors: 360", "    sectors: 2");
   ChildProcess bad({bin("dlslot-detector"), "--config", path, "--check-config"}, dir + "/bad.out");
   EXPECT_EQ(bad.wait(10), 2);
   EXPECT_NE(bad.output().find("ground.sectors"), std::string::npos) << bad.output();

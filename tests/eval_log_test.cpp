@@ -21,9 +21,11 @@
 #include "dlslot/process_status_t.hpp"
 #include "dlslot/slot_state_t.hpp"
 #include "export.hpp"
+#include "text_file.hpp"
 #include "trajectory.hpp"
 
 using namespace dlslot;
+using dlslot::test::readText;
 namespace fs = std::filesystem;
 
 namespace {
@@ -224,12 +226,7 @@ class EvalLog : public ::testing::Test {
     r.err = slurp(err);
     return r;
   }
-  static std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  }
+  static std::string slurp(const fs::path& p) { return readText(p.string()); }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
   fs::path dir_;

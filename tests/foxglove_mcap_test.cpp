@@ -21,8 +21,10 @@
 #include "json_text.hpp"
 #include "mcap_export.hpp"
 #include "mcap_writer.hpp"
+#include "text_file.hpp"
 
 using namespace dlslot;
+using dlslot::test::readText;
 namespace fs = std::filesystem;
 
 namespace {
@@ -31,13 +33,6 @@ std::string scratch(const std::string& name) {
   const std::string dir = std::string(DLSLOT_BIN_DIR) + "/../test-scratch/foxglove_mcap";
   fs::create_directories(dir);
   return dir + "/" + name;
-}
-
-std::string readAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 // A little-endian cursor over MCAP bytes (test-side reader, independent of the writer's Bytes).
@@ -116,7 +111,7 @@ TEST(McapWriter, RecordsIndexesCrcsAndSummaryFollowTheSpecification) {
     EXPECT_EQ(w.messageCount(), 10u);
     w.close();
   }
-  const std::string f = readAll(path);
+  const std::string f = readText(path);
   ASSERT_GT(f.size(), 16u);
   EXPECT_EQ(f.substr(0, 8), std::string(mcap::kMagic, 8));
   EXPECT_EQ(f.substr(f.size() - 8), std::string(mcap::kMagic, 8));
@@ -240,7 +235,7 @@ TEST(McapWriter, RecordsIndexesCrcsAndSummaryFollowTheSpecification) {
 TEST(McapWriter, AnEmptyFileIsValid) {
   const std::string path = scratch("empty.mcap");
   { mcap::Writer w(path); }  // closed by the destructor
-  const std::string f = readAll(path);
+  const std::string f = readText(path);
   const auto data = records(f, 8, f.size() - 8);
   ASSERT_GE(data.size(), 3u);
   EXPECT_EQ(data.front().op, mcap::kHeader);

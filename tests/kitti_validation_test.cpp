@@ -8,9 +8,11 @@
 #include "dlslot/config.hpp"
 #include "dlslot/input_error.hpp"
 #include "dlslot/kitti.hpp"
+#include "text_file.hpp"
 
 using namespace dlslot;
 using namespace dlslot::kitti;
+using dlslot::test::readText;
 namespace fs = std::filesystem;
 
 namespace {
@@ -107,10 +109,7 @@ TEST(KittiValidation, DirectoriesAreRefusedAsSuch) {
 }
 
 TEST(KittiValidation, EvalRefusesAMisspeltConfigSection) {
-  std::ifstream in(std::string(DLSLOT_SOURCE_DIR) + "/config/dlslot.yaml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
+  std::string text = readText(std::string(DLSLOT_SOURCE_DIR) + "/config/dlslot.yaml");
   text.replace(text.find("\ntracker:"), 9, "\ntraker:");
   const std::string cfg = file("misspelt.yaml", text);
   const std::string err = (dir() / "eval.err").string();
@@ -118,9 +117,7 @@ TEST(KittiValidation, EvalRefusesAMisspeltConfigSection) {
                           file("est.txt", "1 0 0 0 0 1 0 0 0 0 1 0\n") + " 2> " + err;
   const int status = std::system(cmd.c_str());
   EXPECT_EQ(WEXITSTATUS(status), 2);
-  std::ifstream e(err);
-  std::stringstream es;
-  es << e.rdbuf();
-  EXPECT_NE(es.str().find(cfg + ": traker"), std::string::npos) << es.str();
-  EXPECT_NE(es.str().find("unknown key"), std::string::npos) << es.str();
+  const std::string es = readText(err);
+  EXPECT_NE(es.find(cfg + ": traker"), std::string::npos) << es;
+  EXPECT_NE(es.find("unknown key"), std::string::npos) << es;
 }

@@ -6,8 +6,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <regex>
-#include <sstream>
 
 #include "dlslot/convert.hpp"
 #include "dlslot/detections_t.hpp"
@@ -35,17 +33,6 @@ struct Listener {
     has_status = true;
   }
 };
-
-std::string configWithTimeout(const std::string& dir, double timeout_s) {
-  std::ifstream in(config());
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string text = std::regex_replace(ss.str(), std::regex("detections_timeout_s: [0-9.]+"),
-                                              "detections_timeout_s: " + std::to_string(timeout_s));
-  const std::string path = dir + "/dlslot.yaml";
-  std::ofstream(path) << text;
-  return path;
-}
 
 }  // namespace
 
@@ -105,7 +92,7 @@ TEST(OdometryProcess, BehindThePlayerOnASimulatedSequence) {
 
 TEST(OdometryProcess, FaultsDoNotStopIt) {
   const std::string dir = scratchDir();
-  ChildProcess odometry({bin("dlslot-odometry"), "--config", configWithTimeout(dir, 0.4)}, dir + "/odometry.out");
+  ChildProcess odometry({bin("dlslot-odometry"), "--config", configWith(dir, "short-wait", "detections_timeout_s: ", "detections_timeout_s: 0.4 #")}, dir + "/odometry.out");
   lcm::LCM lcm;
   ASSERT_TRUE(lcm.good());
   Listener listen;

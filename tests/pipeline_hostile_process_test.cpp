@@ -96,13 +96,6 @@ RunResult runWithInjector(const std::string& data, const std::string& out, std::
   return r;
 }
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 int64_t refusedOn(const process_status_t& s, const std::string& channel) {
   int64_t n = 0;
   for (int i = 0; i < s.num_counters; ++i)
@@ -119,7 +112,7 @@ std::map<std::string, process_status_t> lastStatus(const std::string& log) {
 // The terminal's frame table, report.md and metrics.json give the same count for every process
 // and the same kernel drops.
 void expectCountsAgree(const std::string& out, const std::string& text) {
-  const std::string metrics = readFile(out + "/metrics.json"), report = readFile(out + "/report.md");
+  const std::string metrics = readText(out + "/metrics.json"), report = readText(out + "/report.md");
   ASSERT_FALSE(metrics.empty());
   const std::regex row(R"(^  (\w+) +(\d+) +(\d+) +(\d+) +(\d+)$)");
   int rows = 0;
@@ -180,11 +173,11 @@ TEST(PipelineHostileProcess, WithoutTheKeyNothingChangesAndWithInsecureTheRunSti
   for (const auto& e : fs::directory_iterator(out + "/clean")) {
     const std::string name = e.path().filename().string();
     if (name.rfind("trajectory_", 0) != 0 && name != "tracks_kitti.txt") continue;
-    EXPECT_EQ(readFile(out + "/attacked/" + name), readFile(e.path().string())) << name << " differs from the clean run";
+    EXPECT_EQ(readText(out + "/attacked/" + name), readText(e.path().string())) << name << " differs from the clean run";
     ++compared;
   }
   EXPECT_GE(compared, 4);
-  EXPECT_FALSE(readFile(out + "/attacked/tracks_kitti.txt").empty());
+  EXPECT_FALSE(readText(out + "/attacked/tracks_kitti.txt").empty());
   auto last = lastStatus(out + "/attacked/run.lcmlog");
   for (const auto& [process, channels] : kListens) {
     ASSERT_TRUE(last.count(process)) << process;

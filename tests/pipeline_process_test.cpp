@@ -62,12 +62,6 @@ std::vector<slot_state_t> slotStatesOf(const std::string& log) {
   return states;
 }
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  EXPECT_TRUE(in.good()) << path;
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 std::vector<uint8_t> encoded(slot_state_t s) {
   std::vector<uint8_t> buf(s.getEncodedSize());
   s.encode(buf.data(), 0, buf.size());
@@ -145,7 +139,7 @@ TEST(PipelineProcess, FramesInFlightGiveStrictLockstepResults) {
   const std::string strict = out + "/in-flight-1", overlap = out + "/in-flight-2";
   for (const std::string f : {"trajectory_slot_kitti.txt", "trajectory_slot_smoothed_kitti.txt",
                               "trajectory_odometry_kitti.txt", "tracks_kitti.txt"})
-    EXPECT_EQ(readFile(strict + "/" + f), readFile(overlap + "/" + f)) << f;
+    EXPECT_EQ(readText(strict + "/" + f), readText(overlap + "/" + f)) << f;
   const auto a = slotStatesOf(strict + "/run.lcmlog"), b = slotStatesOf(overlap + "/run.lcmlog");
   ASSERT_EQ(a.size(), static_cast<size_t>(kFrames));
   ASSERT_EQ(a.size(), b.size());
@@ -222,10 +216,7 @@ TEST(PipelineProcess, KilledTrackerIsReportedAndTheLogKept) {
 TEST(PipelineProcess, BadConfigIsRefusedBeforeAnyProcessStarts) {
   const std::string out = scratchDir();
   const std::string shipped = config();
-  std::ifstream in(shipped);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string text = ss.str();
+  const std::string text = readText(shipped);
   struct Case {
     std::string name, yaml, expect;
   };

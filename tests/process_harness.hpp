@@ -27,6 +27,7 @@
 #include "dlslot/lcm_log.hpp"
 #include "dlslot/message_guard.hpp"
 #include "dlslot/node.hpp"
+#include "text_file.hpp"
 
 namespace dlslot::test {
 
@@ -41,10 +42,7 @@ inline std::string config() {
   const std::string shipped = sourceDir() + "/config/dlslot.yaml";
 #ifdef __SANITIZE_ADDRESS__
   static const std::string slow = [&] {
-    std::ifstream in(shipped);
-    std::stringstream text;
-    text << in.rdbuf();
-    std::string yaml = text.str();
+    std::string yaml = readText(shipped);
     const std::string key = "lockstep_timeout_s: 5.0";
     const size_t at = yaml.find(key);
     if (at == std::string::npos) return shipped;  // changed default: the test then says what timed out
@@ -60,6 +58,20 @@ inline std::string config() {
   return shipped;
 #endif
 }
+// A copy of the shipped config (config()) in dir/NAME.yaml with the first `from` replaced by `to`.
+// The test fails when `from` is not there: the config changed under it. Replacing "key: " by
+// "key: VALUE #" sets a value whatever the shipped one is (the old value becomes a comment).
+inline std::string configWith(const std::string& dir, const std::string& name, const std::string& from,
+                              const std::string& to) {
+  std::string text = readText(config());
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "the shipped config has no \"" << from << "\"";
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  const std::string file = dir + "/" + name + ".yaml";
+  std::ofstream(file) << text;
+  return file;
+}
+
 inline std::string realDataRoot() { return sourceDir() + "/../shared/data/kitti-tracking-0000-head"; }
 
 // A fresh scratch directory under the build tree, named after the running test.

@@ -53,24 +53,6 @@ std::vector<std::string> runArgs(const std::string& out, std::vector<std::string
   return a;
 }
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// A copy of the shipped config with `from` replaced by `to`.
-std::string configWith(const std::string& dir, const std::string& name, const std::string& from, const std::string& to) {
-  std::string text = readText(config());
-  const auto at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  const std::string file = dir + "/" + name + ".yaml";
-  std::ofstream(file) << text;
-  return file;
-}
-
 pid_t childNamed(pid_t parent, const std::string& comm) {
   for (pid_t pid : childrenOf(parent)) {
     const auto s = procStat(pid);

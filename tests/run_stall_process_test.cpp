@@ -90,16 +90,9 @@ TEST(RunStallProcess, StoppedOdometryIsReportedByName) {
 TEST(RunStallProcess, SlowOdometryInLockstepLosesNothing) {
   ASSERT_TRUE(insidePrivateNetwork());
   const std::string out = scratchDir();
-  std::ifstream in(config());
-  std::stringstream shipped;
-  shipped << in.rdbuf();
-  std::string yaml = shipped.str();
-  const std::string key = "join_timeout_s: 5.0         # live: how long a scan waits for its SLOT_STATE";
-  const size_t at = yaml.find(key);
-  ASSERT_NE(at, std::string::npos) << "the mapper's join_timeout_s line changed in the shipped config";
-  yaml.replace(at, std::string("join_timeout_s: 5.0").size(), "join_timeout_s: 1.0");
-  const std::string cfg = out + "/short-mapper-wait.yaml";
-  std::ofstream(cfg) << yaml;
+  // The mapper's wait, found by its comment (every process has a join_timeout_s).
+  const std::string cfg = configWith(out, "short-mapper-wait", "join_timeout_s: 5.0         # live: how long a scan waits",
+                                     "join_timeout_s: 1.0         # live: how long a scan waits");
   ChildProcess run(runOnSimulated(out, 60, {}, cfg), out + "/run.log");
   const pid_t odometry = odometryMidRun(run, out);
   ASSERT_GT(odometry, 0) << run.output();

@@ -6,8 +6,6 @@
 
 #include <fstream>
 #include <limits>
-#include <regex>
-#include <sstream>
 
 #include "dlslot/associations_t.hpp"
 #include "dlslot/convert.hpp"
@@ -35,18 +33,6 @@ struct Listener {
   }
 };
 
-// The shipped config with a short join timeout, so the missing-ODOMETRY case is quick.
-std::string configWithTimeout(const std::string& dir, double timeout_s) {
-  std::ifstream in(config());
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string text = std::regex_replace(ss.str(), std::regex("join_timeout_s: [0-9.]+"),
-                                              "join_timeout_s: " + std::to_string(timeout_s));
-  const std::string path = dir + "/dlslot.yaml";
-  std::ofstream(path) << text;
-  return path;
-}
-
 Pose egoAt(int frame) {
   Pose X = Pose::Identity();
   X.linear() = Eigen::AngleAxisd(0.02 * frame, Eigen::Vector3d::UnitZ()).toRotationMatrix();
@@ -60,7 +46,7 @@ TEST(TrackerProcess, RunsInAPrivateNetwork) { EXPECT_TRUE(insidePrivateNetwork()
 
 TEST(TrackerProcess, LockstepFramesWithFaults) {
   const std::string dir = scratchDir();
-  ChildProcess tracker({bin("dlslot-tracker"), "--config", configWithTimeout(dir, 0.4)}, dir + "/tracker.out");
+  ChildProcess tracker({bin("dlslot-tracker"), "--config", configWith(dir, "short-wait", "join_timeout_s: ", "join_timeout_s: 0.4 #")}, dir + "/tracker.out");
   lcm::LCM lcm;
   ASSERT_TRUE(lcm.good());
   Listener listen;
@@ -175,13 +161,7 @@ TEST(TrackerProcess, LockstepFramesWithFaults) {
 
 TEST(TrackerProcess, BadConfigIsRefused) {
   const std::string dir = scratchDir();
-  const std::string path = dir + "/bad.yaml";
-  {
-    std::ifstream in(config());
-    std::stringstream ss;
-    ss << in.rdbuf();
-    std::ofstream(path) << std::regex_replace(ss.str(), std::regex("predictor: polynomial"), "predictor: kalman");
-  }
+  const std::string path = configWith(dir, "bad", "predictor: polynomial", "predictor: kalman");
   ChildProcess tracker({bin("dlslot-tracker"), "--config", path, "--check-config"}, dir + "/tracker.out");
   EXPECT_EQ(tracker.wait(10), 2);
   EXPECT_NE(tracker.output().find("predictor"), std::string::npos) << tracker.output();

@@ -105,11 +105,14 @@ std::string FrameAccounting::table() const {
 
 std::optional<RssSummary> summarizeRss(const std::vector<std::pair<double, int64_t>>& samples) {
   if (samples.empty()) return std::nullopt;
-  const double mid_t = 0.5 * (samples.front().first + samples.back().first);
-  const auto mid = std::min_element(samples.begin(), samples.end(), [&](const auto& x, const auto& y) {
-    return std::abs(x.first - mid_t) < std::abs(y.first - mid_t);
-  });
-  return RssSummary{samples.front().second / 1024.0, mid->second / 1024.0, samples.back().second / 1024.0};
+  const auto mbAt = [&](double fraction) {
+    const double t = samples.front().first + fraction * (samples.back().first - samples.front().first);
+    const auto nearest = std::min_element(samples.begin(), samples.end(), [&](const auto& x, const auto& y) {
+      return std::abs(x.first - t) < std::abs(y.first - t);
+    });
+    return nearest->second / 1024.0;
+  };
+  return RssSummary{mbAt(0.0), mbAt(0.5), mbAt(0.75), mbAt(1.0)};
 }
 
 int64_t residentKb() {

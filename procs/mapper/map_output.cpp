@@ -106,10 +106,18 @@ MapImageStats writeMapImage(const std::string& path, const Mapper& mapper, int m
              cv::Scalar(0, 0, 255), 3, cv::LINE_AA);
   }
   if (!line.empty()) cv::circle(image, line.front(), 6, cv::Scalar(0, 255, 0), -1, cv::LINE_AA);
-  char legend[160];
-  std::snprintf(legend, sizeof legend, "%.2f m/px, height %.1f..%.1f m (blue..red), %d keyframes, %d loops", s.metres_per_pixel,
-                zlo, zhi, static_cast<int>(kfs.size()), mapper.loops().accepted());
-  cv::putText(image, legend, cv::Point(10, 25), cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  // The legend in two lines, scaled down to the image's width (a short drive makes a narrow image).
+  char scale_line[96], count_line[64];
+  std::snprintf(scale_line, sizeof scale_line, "%.2f m/px, height %.1f..%.1f m (blue..red)", s.metres_per_pixel, zlo, zhi);
+  std::snprintf(count_line, sizeof count_line, "%d keyframes, %d loops", static_cast<int>(kfs.size()),
+                mapper.loops().accepted());
+  int baseline = 0;
+  const int widest = cv::getTextSize(scale_line, cv::FONT_HERSHEY_SIMPLEX, 0.6, 1, &baseline).width;
+  const double font = 0.6 * std::min(1.0, (s.width - 20.0) / std::max(1, widest));
+  cv::putText(image, scale_line, cv::Point(10, 10 + static_cast<int>(25 * font)), cv::FONT_HERSHEY_SIMPLEX, font,
+              cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  cv::putText(image, count_line, cv::Point(10, 10 + static_cast<int>(55 * font)), cv::FONT_HERSHEY_SIMPLEX, font,
+              cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   if (!cv::imwrite(path, image)) throw std::runtime_error(path + ": cannot write PNG");
   return s;
 }

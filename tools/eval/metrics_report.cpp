@@ -285,6 +285,7 @@ std::string metricsJson(const Metrics& m) {
   for (const auto& [process, r] : m.memory) {
     kv.emplace_back("memory.rss_mb." + process + ".start", num(r.start_mb));
     kv.emplace_back("memory.rss_mb." + process + ".middle", num(r.middle_mb));
+    kv.emplace_back("memory.rss_mb." + process + ".three_quarters", num(r.three_quarters_mb));
     kv.emplace_back("memory.rss_mb." + process + ".end", num(r.end_mb));
   }
   if (m.map) {
@@ -391,10 +392,10 @@ std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plo
   }
   if (!m.memory.empty()) {
     out << "## Memory (resident, MB)\n\n";
-    Table t({"process", "start", "middle", "end"});
+    Table t({"process", "start", "middle", "3/4", "end"});
     char buf[32];
     auto mb = [&](double v) { std::snprintf(buf, sizeof buf, "%.1f", v); return std::string(buf); };
-    for (const auto& [process, r] : m.memory) t.row({process, mb(r.start_mb), mb(r.middle_mb), mb(r.end_mb)});
+    for (const auto& [process, r] : m.memory) t.row({process, mb(r.start_mb), mb(r.middle_mb), mb(r.three_quarters_mb), mb(r.end_mb)});
     out << t.render() << "\n";
   }
   if (m.map) {

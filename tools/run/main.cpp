@@ -590,11 +590,12 @@ int runPipeline(int argc, char** argv) {
   // Where every frame went, and the memory of each process over the run.
   const FrameAccounting accounting = accountFrames(health, last_frame + 1, accounted);
   std::cerr << accounting.table();
-  std::cerr << "memory (RSS MB, start / middle / end):\n";
+  std::cerr << "memory (RSS MB, start / middle / three quarters / end):\n";
   for (const auto& [p, samples] : rss)
     if (const auto r = summarizeRss(samples)) {
       char line[128];
-      std::snprintf(line, sizeof line, "  %-10s %7.1f %7.1f %7.1f\n", p.c_str(), r->start_mb, r->middle_mb, r->end_mb);
+      std::snprintf(line, sizeof line, "  %-10s %7.1f %7.1f %7.1f %7.1f\n", p.c_str(), r->start_mb, r->middle_mb,
+                    r->three_quarters_mb, r->end_mb);
       std::cerr << line;
     }
   if (const auto refused = node.status().refusals(); !refused.empty()) {

@@ -53,11 +53,14 @@ FrameAccounting accountFrames(const std::map<std::string, process_status_t>& las
 int64_t statusCounter(const process_status_t& s, const std::string& name);
 
 // Resident memory of a process over a run, from its PROCESS_STATUS samples (counter rss_kb).
+// The sample at three quarters of the run beside the end shows whether memory is flat in a run's
+// last quarter (a soak whose map stops growing half-way).
 struct RssSummary {
-  double start_mb = 0, middle_mb = 0, end_mb = 0;
+  double start_mb = 0, middle_mb = 0, three_quarters_mb = 0, end_mb = 0;
 };
-// `samples`: (time in seconds, rss in kB), in time order. The middle sample is the one nearest the
-// midpoint of the first and last times. Empty input gives nullopt.
+// `samples`: (time in seconds, rss in kB), in time order. The middle (three-quarters) sample is the
+// one nearest the half (three quarters) of the way from the first to the last time. Empty input
+// gives nullopt.
 std::optional<RssSummary> summarizeRss(const std::vector<std::pair<double, int64_t>>& samples);
 
 // This process's resident set in kB (/proc/self/statm); 0 when unknown.

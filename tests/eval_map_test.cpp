@@ -8,6 +8,7 @@
 
 #include <random>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "dlslot/voxel_key.hpp"
 #include "map_quality.hpp"
@@ -179,4 +180,31 @@ TEST(MapTruth, StructureTheMapLostStaysLost) {
   MapTruthOptions coarse;
   coarse.coincidence_m = 0.1;
   EXPECT_THROW(scoreMap(PointCloud(4, 0), {}, none, coarse), std::invalid_argument);
+}
+
+// A keyframe inserted after the loop, on the corrected grid: where its points found their voxel
+// held (by points the correction moved there) the mapper added nothing, and the voxel still counts
+// as held, as the mapper decided.
+TEST(MapTruth, AKeyframeInsertedAfterALoopIsJudgedOnTheCorrectedGrid) {
+  const std::set<int> none;
+  const Pose correction(Eigen::Translation3d(0.1, 0.1, 0.1));
+  Wall w = scannedWall(correction);
+  std::unordered_set<uint64_t> cells;
+  for (Eigen::Index i = 0; i < w.map.cols(); ++i) cells.insert(voxelKey(w.map.col(i).head<3>().cast<double>(), 0.2));
+  MapKeyframe after = w.keyframes[5];  // the same wall seen again, inserted with the corrected pose
+  after.frame = 10;
+  after.T_grid_lidar = after.T_map_lidar;
+  std::vector<Eigen::Vector3d> added;
+  for (Eigen::Index i = 0; i < after.scan.cols(); ++i) {
+    const Eigen::Vector3d q = after.T_map_lidar * after.scan.col(i).head<3>().cast<double>();
+    if (cells.insert(voxelKey(q, 0.2)).second) added.push_back(q);
+  }
+  EXPECT_LT(added.size(), static_cast<size_t>(w.map.cols()) / 2);  // mostly held already
+  const Eigen::Index n = w.map.cols();
+  w.map.conservativeResize(4, n + static_cast<Eigen::Index>(added.size()));
+  for (size_t i = 0; i < added.size(); ++i) w.map.col(n + static_cast<Eigen::Index>(i)) << added[i].cast<float>(), 0.5f;
+  w.keyframes.push_back(after);
+  const MapScore s = scoreMap(w.map, w.keyframes, none, MapTruthOptions{});
+  ASSERT_TRUE(s.sa);
+  EXPECT_DOUBLE_EQ(*s.sa, 1.0);
 }

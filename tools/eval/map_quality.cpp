@@ -87,6 +87,11 @@ MapScore scoreMap(const PointCloud& map_points, const std::vector<MapKeyframe>& 
   const double lo = o.min_range_m * o.min_range_m, hi = o.max_range_m * o.max_range_m;
   for (const MapKeyframe& kf : keyframes) {
     const Pose& T_grid = kf.T_grid_lidar ? *kf.T_grid_lidar : kf.T_map_lidar;
+    // A keyframe inserted on the map's final grid (no loop correction since: every keyframe
+    // without loops, those after the last loop with them): where its point found its cell held, the
+    // mapper added nothing, and the point standing for the cell may be another keyframe's, moved
+    // there by the correction. So on that grid a voxel is also held when the map has a point in it.
+    const bool final_grid = (T_grid.matrix() - kf.T_map_lidar.matrix()).cwiseAbs().maxCoeff() < 1e-6;
     std::vector<const MovingBox*> boxes;
     for (const MovingBox& b : kf.labels)
       if (moving.count(b.box.id)) boxes.push_back(&b);
@@ -97,7 +102,10 @@ MapScore scoreMap(const PointCloud& map_points, const std::vector<MapKeyframe>& 
       // Whether the voxel is held is asked of every point the mapper looked at, scored or not
       // (a voxel's map point may be one outside the camera's view or in a DontCare box).
       const uint64_t key = voxelKey(T_grid * p, o.voxel_m);
-      if (!held.count(key) && inMap(kf.T_map_lidar * p)) held.insert(key);
+      if (!held.count(key)) {
+        const Eigen::Vector3d q = kf.T_map_lidar * p;
+        if ((final_grid && map_cells.count(key)) || inMap(q)) held.insert(key);
+      }
       if (o.T_cam_lidar) {
         const Eigen::Vector3d c = *o.T_cam_lidar * p;  // camera: z forward, x right
         if (c.z() <= 0 || std::abs(std::atan2(c.x(), c.z())) > o.camera_half_fov_rad) continue;

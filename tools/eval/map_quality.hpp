@@ -9,8 +9,9 @@
 // AA = sqrt(SA x DA). The voxels are those of the grid the map counted its points on: each
 // keyframe's points placed with the pose it was inserted with (MapKeyframe::T_grid_lidar), and a
 // voxel is held when one of its points is in the map (the map keeps, per voxel, one point of the
-// keyframes' scans, moved with its keyframe by any loop correction). Without a loop that is the
-// map's own grid and the test is "the map has a point in the voxel"; after one, a sub-voxel shift
+// keyframes' scans, moved with its keyframe by any loop correction), or, for a keyframe inserted
+// on the map's final grid, when the map has a point in the voxel (as the mapper decided). Without
+// a loop that is the old test, "the map has a point in the voxel"; after one, a sub-voxel shift
 // of the map would otherwise spread the dense truth of one voxel over up to 8 voxels of the moved
 // grid while its one map point lands in one of them, and SA would count the others as lost
 // structure (urban-loop: 0.71 where the map had lost none).

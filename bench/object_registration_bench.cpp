@@ -1,12 +1,19 @@
 // Per-object registration of one frame: 20 cars at 8-40 m (ray-cast box scans, as in
 // tests/object_scan.hpp), each registered from a prediction 0.3 m and 2 deg off (goal: <= 3 ms a
-// frame on one thread). Beside it, PCL's GICP on the same pairs: why the registration has its
-// own voxel-grid correspondences.
+// frame on one thread). A frame's cost is preparing each object's current points (which the next
+// frame reuses as its previous ones) and registering: RegisterTwentyObjects. Beside it, the same
+// with both clouds prepared for each registration, the preparation alone, and PCL's pieces for
+// the same jobs (VoxelGrid + KdTreeFLANN + NormalEstimation; kd-tree nearest-point queries; GICP):
+// why the registration has its own voxel-grid correspondences.
 #include <benchmark/benchmark.h>
 
+#include <pcl/features/normal_3d.h>
+#include <pcl/filters/voxel_grid.h>
+#include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_types.h>
 #include <pcl/registration/gicp.h>
 
+#include <Eigen/Eigenvalues>
 #include <random>
 
 #include "backend/object_registration.hpp"
@@ -51,40 +58,187 @@ std::vector<Pair> makeFrame(int objects, unsigned seed) {
   return out;
 }
 
-void BM_RegisterTwentyObjects(benchmark::State& state) {
-  const std::vector<Pair> frame = makeFrame(20, 1);
-  const RegistrationOptions options;
+struct Errors {
   int measured = 0, iterations = 0, full = 0;
   double error2 = 0, full_error2 = 0;  // the measured results' error at the previous points' centroid (m^2)
-  for (auto _ : state) {
-    measured = iterations = 0;
-    error2 = full_error2 = 0;
-    full = 0;
-    for (const Pair& p : frame) {
-      const RegistrationResult r = registerObject(p.previous, p.current, p.prediction, p.range, options);
-      iterations += r.iterations;
-      if (!r.ok()) continue;
-      ++measured;
-      const double e2 = (r.motion * p.centroid - p.truth * p.centroid).squaredNorm();
-      error2 += e2;
-      if (r.outcome == RegistrationOutcome::kMeasured) {
-        full_error2 += e2;
-        ++full;
-      }
+  double measured_dirs_error2 = 0;     // of its horizontal directions said measured (sigma < 3 cm)
+  void add(const RegistrationResult& r, const Pair& p) {
+    iterations += r.iterations;
+    if (!r.ok()) return;
+    ++measured;
+    const Eigen::Vector3d e = r.motion * p.centroid - p.truth * p.centroid;
+    const double e2 = e.squaredNorm();
+    error2 += e2;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(r.information.topLeftCorner<2, 2>());
+    double worst = 0;
+    for (int k = 0; k < 2; ++k)
+      if (es.eigenvalues()[k] > 1.0 / (0.03 * 0.03)) worst = std::max(worst, std::abs(es.eigenvectors().col(k).dot(e.head<2>())));
+    measured_dirs_error2 += worst * worst;
+    if (r.outcome == RegistrationOutcome::kMeasured) {
+      full_error2 += e2;
+      ++full;
     }
   }
-  state.counters["measured"] = measured;
-  state.counters["iterations_per_object"] = double(iterations) / frame.size();
-  // Of every result (a partial one's unmeasured direction is the prediction's) and of the fully
-  // measured ones.
-  state.counters["rms_error_m"] = std::sqrt(error2 / std::max(1, measured));
-  state.counters["full"] = full;
-  state.counters["full_rms_error_m"] = std::sqrt(full_error2 / std::max(1, full));
-  long points = 0;
-  for (const Pair& p : frame) points += static_cast<long>(p.previous.size());
-  state.counters["points_per_object"] = double(points) / frame.size();
+  void report(benchmark::State& state, const std::vector<Pair>& frame) const {
+    state.counters["measured"] = measured;
+    state.counters["iterations_per_object"] = double(iterations) / frame.size();
+    // Of every result (a partial one's unmeasured direction is the prediction's) and of the fully
+    // measured ones.
+    state.counters["rms_error_m"] = std::sqrt(error2 / std::max(1, measured));
+    state.counters["full"] = full;
+    state.counters["full_rms_error_m"] = std::sqrt(full_error2 / std::max(1, full));
+    state.counters["measured_dirs_rms_error_m"] = std::sqrt(measured_dirs_error2 / std::max(1, measured));
+    long points = 0;
+    for (const Pair& p : frame) points += static_cast<long>(p.previous.size());
+    state.counters["points_per_object"] = double(points) / frame.size();
+  }
+};
+
+// A frame in the backend: each track's previous points were prepared in the previous frame; its
+// current ones are prepared now (and kept for the next frame), then registered.
+void registerFrame(benchmark::State& state, const RegistrationOptions& options) {
+  const std::vector<Pair> frame = makeFrame(20, 1);
+  std::vector<PreparedObject> previous;
+  for (const Pair& p : frame) previous.emplace_back(p.previous, p.range, options);
+  Errors errors;
+  for (auto _ : state) {
+    errors = Errors{};
+    for (size_t i = 0; i < frame.size(); ++i) {
+      const Pair& p = frame[i];
+      const PreparedObject current(p.current, p.range, options);
+      errors.add(registerObject(previous[i], current, p.prediction, options), p);
+    }
+  }
+  errors.report(state, frame);
 }
+
+void BM_RegisterTwentyObjects(benchmark::State& state) { registerFrame(state, RegistrationOptions{}); }
 BENCHMARK(BM_RegisterTwentyObjects)->Unit(benchmark::kMillisecond);
+
+// All six directions fitted (planar off): the height drifts (full_rms_error_m).
+void BM_RegisterTwentyObjectsSixDof(benchmark::State& state) {
+  RegistrationOptions options;
+  options.planar = false;
+  registerFrame(state, options);
+}
+BENCHMARK(BM_RegisterTwentyObjectsSixDof)->Unit(benchmark::kMillisecond);
+
+// Both clouds prepared for each registration (no reuse from the previous frame).
+void BM_RegisterTwentyObjectsBothPrepared(benchmark::State& state) {
+  const std::vector<Pair> frame = makeFrame(20, 1);
+  const RegistrationOptions options;
+  Errors errors;
+  for (auto _ : state) {
+    errors = Errors{};
+    for (const Pair& p : frame) errors.add(registerObject(p.previous, p.current, p.prediction, p.range, options), p);
+  }
+  errors.report(state, frame);
+}
+BENCHMARK(BM_RegisterTwentyObjectsBothPrepared)->Unit(benchmark::kMillisecond);
+
+// The preparation alone: thinning to one point per half voxel, the voxel grid, the planes of the
+// (at most 80) source points.
+void BM_PrepareTwentyObjects(benchmark::State& state) {
+  const std::vector<Pair> frame = makeFrame(20, 1);
+  const RegistrationOptions options;
+  for (auto _ : state)
+    for (const Pair& p : frame) benchmark::DoNotOptimize(PreparedObject(p.current, p.range, options).sourcePlanes().data());
+}
+BENCHMARK(BM_PrepareTwentyObjects)->Unit(benchmark::kMillisecond);
+
+pcl::PointCloud<pcl::PointXYZ>::Ptr toPcl(const ObjectPoints& pts);
+
+// The same preparation from PCL's pieces: VoxelGrid at the same half voxel, a KdTreeFLANN on its
+// output, normals of 80 of its points from their 8 nearest neighbours.
+void BM_PclPrepareTwentyObjects(benchmark::State& state) {
+  const std::vector<Pair> frame = makeFrame(20, 1);
+  const RegistrationOptions options;
+  std::vector<pcl::PointCloud<pcl::PointXYZ>::Ptr> clouds;
+  for (const Pair& p : frame) clouds.push_back(toPcl(p.current));
+  for (auto _ : state)
+    for (size_t i = 0; i < frame.size(); ++i) {
+      const float leaf = static_cast<float>(0.5 * std::max(options.min_voxel, options.voxel_per_m * frame[i].range));
+      auto thinned = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+      pcl::VoxelGrid<pcl::PointXYZ> grid;
+      grid.setInputCloud(clouds[i]);
+      grid.setLeafSize(leaf, leaf, leaf);
+      grid.filter(*thinned);
+      auto tree = std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
+      pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+      ne.setInputCloud(thinned);
+      ne.setSearchMethod(tree);  // builds the kd-tree on the thinned points
+      ne.setKSearch(options.plane_neighbours);
+      auto indices = std::make_shared<pcl::Indices>();
+      const size_t m = std::min<size_t>(thinned->size(), options.max_source_points);
+      for (size_t k = 0; k < m; ++k) indices->push_back(static_cast<int>(k * thinned->size() / m));
+      ne.setIndices(indices);
+      pcl::PointCloud<pcl::Normal> normals;
+      ne.compute(normals);
+      benchmark::DoNotOptimize(normals.data());
+    }
+}
+BENCHMARK(BM_PclPrepareTwentyObjects)->Unit(benchmark::kMillisecond);
+
+// Nearest-point queries as the Gauss-Newton loop makes them (each object's source points at 8
+// poses from the prediction to the truth): the voxel grid's against a KdTreeFLANN's on the same
+// thinned points.
+Pose between(const Pose& a, const Pose& b, double s) {
+  Pose m = Pose::Identity();
+  m.linear() = Eigen::Quaterniond(a.linear()).slerp(s, Eigen::Quaterniond(b.linear())).toRotationMatrix();
+  m.translation() = (1 - s) * a.translation() + s * b.translation();
+  return m;
+}
+
+std::vector<std::vector<Eigen::Vector3d>> nearestQueries(const std::vector<Pair>& frame, const std::vector<PreparedObject>& prev) {
+  std::vector<std::vector<Eigen::Vector3d>> out(frame.size());
+  for (size_t i = 0; i < frame.size(); ++i)
+    for (int k = 0; k < 8; ++k) {
+      const Pose M = between(frame[i].prediction, frame[i].truth, k / 7.0);
+      for (const Eigen::Vector3d& p : prev[i].sourcePoints()) out[i].push_back(M * p);
+    }
+  return out;
+}
+
+void BM_GridNearestTwentyObjects(benchmark::State& state) {
+  const std::vector<Pair> frame = makeFrame(20, 1);
+  const RegistrationOptions options;
+  std::vector<PreparedObject> prev, cur;
+  for (const Pair& p : frame) {
+    prev.emplace_back(p.previous, p.range, options);
+    cur.emplace_back(p.current, p.range, options);
+  }
+  const auto queries = nearestQueries(frame, prev);
+  for (auto _ : state)
+    for (size_t i = 0; i < frame.size(); ++i)
+      for (const Eigen::Vector3d& q : queries[i]) {
+        double d2;
+        benchmark::DoNotOptimize(cur[i].nearest(q, &d2));
+      }
+  state.counters["queries_per_object"] = double(queries[0].size());
+}
+BENCHMARK(BM_GridNearestTwentyObjects)->Unit(benchmark::kMillisecond);
+
+void BM_PclNearestTwentyObjects(benchmark::State& state) {
+  const std::vector<Pair> frame = makeFrame(20, 1);
+  const RegistrationOptions options;
+  std::vector<PreparedObject> prev;
+  std::vector<pcl::KdTreeFLANN<pcl::PointXYZ>> trees(frame.size());
+  for (size_t i = 0; i < frame.size(); ++i) {
+    prev.emplace_back(frame[i].previous, frame[i].range, options);
+    const PreparedObject cur(frame[i].current, frame[i].range, options);
+    auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+    for (const Eigen::Vector3d& p : cur.points()) cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    trees[i].setInputCloud(cloud);
+  }
+  const auto queries = nearestQueries(frame, prev);
+  pcl::Indices index(1);
+  std::vector<float> d2(1);
+  for (auto _ : state)
+    for (size_t i = 0; i < frame.size(); ++i)
+      for (const Eigen::Vector3d& q : queries[i])
+        benchmark::DoNotOptimize(trees[i].nearestKSearch(pcl::PointXYZ(q.x(), q.y(), q.z()), 1, index, d2));
+}
+BENCHMARK(BM_PclNearestTwentyObjects)->Unit(benchmark::kMillisecond);
 
 pcl::PointCloud<pcl::PointXYZ>::Ptr toPcl(const ObjectPoints& pts) {
   auto c = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();

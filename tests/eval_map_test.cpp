@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <unordered_map>
 
 #include "dlslot/voxel_key.hpp"
 #include "map_quality.hpp"
@@ -102,4 +103,80 @@ TEST(MapTruth, AMapWithoutThePassingCarScoresOneOnBothCounts) {
   const MapScore naive = scoreMap(s.rail_only, s.keyframes, moving, old);
   ASSERT_TRUE(naive.sa);
   EXPECT_LT(*naive.sa, 0.95);
+}
+
+namespace {
+
+// A wall scanned from ten keyframes 1 m apart (each keyframe's points spread over it, with range
+// noise), and the map the mapper makes of it: the first point of each 0.2 m voxel, counted with
+// the keyframes' poses at insertion, then moved with its keyframe by `correction` (a loop
+// correction moving the keyframes, and the truth placed with the corrected poses, together).
+struct Wall {
+  std::vector<MapKeyframe> keyframes;
+  PointCloud map;
+};
+
+Wall scannedWall(const Pose& correction, double gap_from_x = 1e9, double gap_to_x = -1e9) {
+  Wall w;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> along(-15.0, 15.0), up(-1.5, 2.0);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  std::unordered_map<uint64_t, Eigen::Vector3d> first;
+  std::vector<uint64_t> order;
+  for (int k = 0; k < 10; ++k) {
+    MapKeyframe kf;
+    kf.frame = k;
+    const Pose inserted(Eigen::Translation3d(k, 0, 0));
+    kf.T_grid_lidar = inserted;
+    kf.T_map_lidar = correction * inserted;
+    kf.scan.resize(4, 20000);
+    for (Eigen::Index i = 0; i < kf.scan.cols(); ++i) {
+      const Eigen::Vector3d p(along(rng), 6.05 + noise(rng), up(rng));
+      kf.scan.col(i) << p.cast<float>(), 0.5f;
+      const Eigen::Vector3d at_insertion = inserted * p;
+      if (at_insertion.x() >= gap_from_x && at_insertion.x() < gap_to_x) continue;  // structure the map lost
+      const uint64_t key = voxelKey(at_insertion, 0.2);
+      if (first.emplace(key, correction * at_insertion).second) order.push_back(key);
+    }
+    w.keyframes.push_back(std::move(kf));
+  }
+  w.map.resize(4, static_cast<Eigen::Index>(order.size()));
+  for (size_t i = 0; i < order.size(); ++i) w.map.col(static_cast<Eigen::Index>(i)) << first[order[i]].cast<float>(), 0.5f;
+  return w;
+}
+
+}  // namespace
+
+// Moved by half a voxel, the map holds every bit of the wall it held before. Counted on the moved
+// grid (the rule before), each voxel's dense truth would spread over 4 voxels and its one map
+// point land in one of them: a third of the wall "lost".
+TEST(MapTruth, AMapMovedByHalfAVoxelKeepsItsStructure) {
+  const std::set<int> none;
+  const Wall still = scannedWall(Pose::Identity());
+  const MapScore a = scoreMap(still.map, still.keyframes, none, MapTruthOptions{});
+  ASSERT_TRUE(a.sa);
+  EXPECT_DOUBLE_EQ(*a.sa, 1.0);
+  Wall moved = scannedWall(Pose(Eigen::Translation3d(0.1, 0.1, 0.1)));
+  const MapScore b = scoreMap(moved.map, moved.keyframes, none, MapTruthOptions{});
+  ASSERT_TRUE(b.sa);
+  EXPECT_DOUBLE_EQ(*b.sa, 1.0);
+  EXPECT_EQ(b.static_voxels, a.static_voxels);
+  for (MapKeyframe& k : moved.keyframes) k.T_grid_lidar.reset();  // the moved grid
+  const MapScore old = scoreMap(moved.map, moved.keyframes, none, MapTruthOptions{});
+  ASSERT_TRUE(old.sa);
+  EXPECT_LT(*old.sa, 0.8);
+}
+
+// What the map lost stays lost, moved or not: a 2 m stretch of the 39 m of wall.
+TEST(MapTruth, StructureTheMapLostStaysLost) {
+  const std::set<int> none;
+  for (const Pose& correction : {Pose::Identity(), Pose(Eigen::Translation3d(0.1, 0.1, 0.1))}) {
+    const Wall w = scannedWall(correction, 10.0, 12.0);
+    const MapScore s = scoreMap(w.map, w.keyframes, none, MapTruthOptions{});
+    ASSERT_TRUE(s.sa);
+    EXPECT_NEAR(*s.sa, 1.0 - 2.0 / 39.0, 0.005) << correction.translation().transpose();
+  }
+  MapTruthOptions coarse;
+  coarse.coincidence_m = 0.1;
+  EXPECT_THROW(scoreMap(PointCloud(4, 0), {}, none, coarse), std::invalid_argument);
 }

@@ -6,6 +6,7 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
@@ -173,6 +174,24 @@ TEST(VoxelMap, VoxelsFollowTheirKeyframesWhenTheGraphMovesThem) {
   for (Eigen::Index i = 0; i < c.cols(); ++i) moved += std::abs(c(1, i) - 2.05f) < 1e-4;
   EXPECT_EQ(moved, 2);
   EXPECT_EQ(map.size(), 4u);
+}
+
+// A loop correction moves keyframes by sub-voxel amounts: two voxels that land in one cell are
+// both kept (merging would thin the map only because the grid moved), and the cell, held, takes
+// no new voxel.
+TEST(VoxelMap, AReposeKeepsVoxelsThatNowShareACell) {
+  VoxelMap map(0.2);
+  EXPECT_EQ(map.insert(0, Pose::Identity(), toCloud({{1.05, 0.05, 0.05}})), 1u);
+  EXPECT_EQ(map.insert(1, Pose::Identity(), toCloud({{1.25, 0.05, 0.05}})), 1u);
+  map.repose({Pose::Identity(), poseXYYaw(-0.1, 0, 0)});  // keyframe 1's point now at x = 1.15, in keyframe 0's cell
+  ASSERT_EQ(map.size(), 2u);
+  const PointCloud c = map.cloud();
+  std::vector<float> xs{c(0, 0), c(0, 1)};
+  std::sort(xs.begin(), xs.end());
+  EXPECT_NEAR(xs[0], 1.05f, 1e-5);
+  EXPECT_NEAR(xs[1], 1.15f, 1e-5);
+  EXPECT_EQ(map.insert(2, Pose::Identity(), toCloud({{1.1, 0.05, 0.05}})), 0u);
+  EXPECT_EQ(map.size(), 2u);
 }
 
 TEST(VoxelMap, CountsTheSameCellsAsVoxelKeyOnBothSidesOfTheOrigin) {

@@ -8,132 +8,10 @@
 namespace dlslot::backend {
 namespace {
 
-// The current points binned in a dense voxel grid (point indices per voxel). A query's nearest
-// point is searched in its voxel's 3x3x3 neighbourhood; each target point's plane (its nearest
-// neighbours there, one 3x3 eigen-decomposition) is fitted on first use and cached.
-class PlaneGrid {
- public:
-  struct Plane {
-    bool valid = false;
-    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-  };
-
-  PlaneGrid(const std::vector<Eigen::Vector3d>& points, double voxel, int pad, const RegistrationOptions& o)
-      : points_(points), options_(o) {
-    Eigen::Vector3d lo = points.front(), hi = points.front();
-    for (const Eigen::Vector3d& p : points) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    // A long truck at a small voxel: grow the voxel until the grid stays small.
-    for (;;) {
-      origin_ = lo - Eigen::Vector3d::Constant(pad * voxel);
-      for (int k = 0; k < 3; ++k) dims_[k] = static_cast<int>(std::floor((hi[k] - lo[k]) / voxel)) + 1 + 2 * pad;
-      if (static_cast<long>(dims_[0]) * dims_[1] * dims_[2] <= 200'000) break;
-      voxel *= 1.5;
-    }
-    voxel_ = voxel;
-    const size_t n = static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2];
-    start_.assign(n + 1, 0);
-    std::vector<long> cell(points.size());
-    for (size_t i = 0; i < points.size(); ++i) {
-      cell[i] = index(points[i]);
-      ++start_[cell[i] + 1];
-    }
-    for (size_t k = 1; k < start_.size(); ++k) start_[k] += start_[k - 1];
-    members_.resize(points.size());
-    std::vector<int> next(start_.begin(), start_.end() - 1);
-    for (size_t i = 0; i < points.size(); ++i) members_[next[cell[i]]++] = static_cast<int>(i);
-    planes_.resize(points.size());
-    fitted_.assign(points.size(), 0);
-  }
-
-  // The nearest point to q within one voxel's reach (-1: none), and its squared distance.
-  int nearest(const Eigen::Vector3d& q, double* d2) const {
-    int best = -1;
-    double best_d2 = 1e300;
-    forNeighbourhood(q, [&](int j) {
-      const double d = (points_[j] - q).squaredNorm();
-      if (d < best_d2) {
-        best_d2 = d;
-        best = j;
-      }
-    });
-    *d2 = best_d2;
-    return best;
-  }
-
-  const Plane& plane(int j) {
-    if (!fitted_[j]) fit(j);
-    return planes_[j];
-  }
-
- private:
-  long index(const Eigen::Vector3d& p) const {
-    int c[3];
-    if (!cellOf(p, c)) return -1;
-    return (static_cast<long>(c[2]) * dims_[1] + c[1]) * dims_[0] + c[0];
-  }
-  bool cellOf(const Eigen::Vector3d& p, int* c) const {
-    for (int k = 0; k < 3; ++k) {
-      const double f = (p[k] - origin_[k]) / voxel_;
-      if (!(f >= 0) || f >= dims_[k]) return false;
-      c[k] = static_cast<int>(f);
-    }
-    return true;
-  }
-  template <typename F>
-  void forNeighbourhood(const Eigen::Vector3d& q, F&& each) const {
-    int c[3];
-    if (!cellOf(q, c)) return;
-    for (int z = std::max(0, c[2] - 1); z <= std::min(dims_[2] - 1, c[2] + 1); ++z)
-      for (int y = std::max(0, c[1] - 1); y <= std::min(dims_[1] - 1, c[1] + 1); ++y)
-        for (int x = std::max(0, c[0] - 1); x <= std::min(dims_[0] - 1, c[0] + 1); ++x) {
-          const long k = (static_cast<long>(z) * dims_[1] + y) * dims_[0] + x;
-          for (int m = start_[k]; m < start_[k + 1]; ++m) each(members_[m]);
-        }
-  }
-
-  void fit(int j) {
-    fitted_[j] = 1;
-    const Eigen::Vector3d& p = points_[j];
-    near_.clear();
-    auto& near = near_;
-    forNeighbourhood(p, [&](int m) { near.emplace_back((points_[m] - p).squaredNorm(), m); });
-    const int k = std::min<int>(static_cast<int>(near.size()), options_.plane_neighbours);
-    if (k < options_.min_plane_points) return;
-    std::nth_element(near.begin(), near.begin() + (k - 1), near.end());
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int i = 0; i < k; ++i) mean += points_[near[i].second];
-    mean /= k;
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (int i = 0; i < k; ++i) {
-      const Eigen::Vector3d d = points_[near[i].second] - mean;
-      cov += d * d.transpose();
-    }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
-    es.computeDirect(cov / k);
-    const Eigen::Vector3d ev = es.eigenvalues();  // ascending
-    // A plane: one small eigenvalue, two spread ones (a single scan ring is a line: no plane).
-    if (!(ev[1] > 1e-6) || ev[0] > options_.max_planarity * ev[1]) return;
-    planes_[j] = Plane{true, es.eigenvectors().col(0)};
-  }
-
-  const std::vector<Eigen::Vector3d>& points_;
-  const RegistrationOptions& options_;
-  Eigen::Vector3d origin_;
-  int dims_[3];
-  double voxel_;
-  std::vector<int> start_, members_;
-  std::vector<Plane> planes_;
-  std::vector<char> fitted_;
-  std::vector<std::pair<double, int>> near_;
-};
-
 // One point per cell of edge `cell` (the first one met), then every k-th of those if more than
 // `max_points` remain. Cells, not a stride over the scan: a scan lists its points ring by ring,
 // and every k-th point of that order leaves lines, not surfaces.
-std::vector<Eigen::Vector3d> thin(const ObjectPoints& points, const Eigen::Vector3d& shift, double cell, int max_points) {
+std::vector<Eigen::Vector3d> thin(const ObjectPoints& points, double cell, int max_points) {
   std::vector<Eigen::Vector3d> out;
   if (points.empty()) return out;
   Eigen::Vector3d lo = points.front().cast<double>(), hi = lo;
@@ -163,7 +41,7 @@ std::vector<Eigen::Vector3d> thin(const ObjectPoints& points, const Eigen::Vecto
     char& t = taken[static_cast<size_t>((c[2] * dims[1] + c[1]) * dims[0] + c[0])];
     if (t) continue;
     t = 1;
-    out.push_back(q - shift);
+    out.push_back(q);
   }
   if (static_cast<int>(out.size()) > max_points) {
     const double step = static_cast<double>(out.size()) / max_points;
@@ -189,27 +67,163 @@ const char* toString(RegistrationOutcome outcome) {
   return "?";
 }
 
+PreparedObject::PreparedObject(const ObjectPoints& points, double range, const RegistrationOptions& o)
+    : raw_points_(static_cast<int>(points.size())) {
+  voxel_ = std::max(o.min_voxel, o.voxel_per_m * range);
+  if (points.empty()) return;
+  // A near car has thousands of points: thinned to one point per half voxel (and a bounded
+  // number), which bounds the work per object.
+  points_ = thin(points, 0.5 * voxel_, o.max_target_points);
+  for (const Eigen::Vector3d& p : points_) centroid_ += p;
+  centroid_ /= static_cast<double>(points_.size());
+  Eigen::Vector3d lo = points_.front(), hi = points_.front();
+  for (const Eigen::Vector3d& p : points_) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  // A long truck at a small voxel: grow the voxel until the grid stays small.
+  const int pad = 2;
+  for (;;) {
+    origin_ = lo - Eigen::Vector3d::Constant(pad * voxel_);
+    for (int k = 0; k < 3; ++k) dims_[k] = static_cast<int>(std::floor((hi[k] - lo[k]) / voxel_)) + 1 + 2 * pad;
+    if (static_cast<long>(dims_[0]) * dims_[1] * dims_[2] <= 200'000) break;
+    voxel_ *= 1.5;
+  }
+  const size_t n = static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2];
+  start_.assign(n + 1, 0);
+  std::vector<long> cell(points_.size());
+  for (size_t i = 0; i < points_.size(); ++i) {
+    int c[3] = {0, 0, 0};
+    cellOf(points_[i], c);  // inside: the grid spans the points
+    cell[i] = (static_cast<long>(c[2]) * dims_[1] + c[1]) * dims_[0] + c[0];
+    ++start_[cell[i] + 1];
+  }
+  for (size_t k = 1; k < start_.size(); ++k) start_[k] += start_[k - 1];
+  members_.resize(points_.size());
+  std::vector<int> next(start_.begin(), start_.end() - 1);
+  for (size_t i = 0; i < points_.size(); ++i) members_[next[cell[i]]++] = static_cast<int>(i);
+  // The source subsample: every k-th point (the thinned points are in scan order, cell by cell),
+  // each with its plane.
+  const size_t m = std::min(points_.size(), static_cast<size_t>(std::max(1, o.max_source_points)));
+  const double step = static_cast<double>(points_.size()) / static_cast<double>(m);
+  source_.reserve(m);
+  planes_.reserve(m);
+  for (size_t i = 0; i < m; ++i) {
+    source_.push_back(points_[static_cast<size_t>(static_cast<double>(i) * step)]);
+    planes_.push_back(fit(source_.back(), o));
+  }
+}
+
+bool PreparedObject::cellOf(const Eigen::Vector3d& p, int* c) const {
+  for (int k = 0; k < 3; ++k) {
+    const double f = (p[k] - origin_[k]) / voxel_;
+    if (!(f >= 0) || f >= dims_[k]) return false;
+    c[k] = static_cast<int>(f);
+  }
+  return true;
+}
+
+int PreparedObject::nearest(const Eigen::Vector3d& q, double* d2) const {
+  int best = -1;
+  double best_d2 = 1e300;
+  *d2 = best_d2;
+  int c[3];
+  if (!cellOf(q, c)) return best;
+  // First the 2x2x2 voxels on q's side of its voxel: they hold every point within half a voxel
+  // of q, so a point found there that near is the nearest of the 3x3x3 neighbourhood too (most
+  // queries, once the iterations settle, at 8 voxels instead of 27).
+  int lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    const double f = (q[k] - origin_[k]) / voxel_ - c[k];
+    lo[k] = std::max(0, f < 0.5 ? c[k] - 1 : c[k]);
+    hi[k] = std::min(dims_[k] - 1, f < 0.5 ? c[k] : c[k] + 1);
+  }
+  auto scan = [&](const int* a, const int* b) {
+    for (int z = a[2]; z <= b[2]; ++z)
+      for (int y = a[1]; y <= b[1]; ++y) {
+        const long row = (static_cast<long>(z) * dims_[1] + y) * dims_[0];
+        for (int m = start_[row + a[0]]; m < start_[row + b[0] + 1]; ++m) {
+          const double d = (points_[members_[m]] - q).squaredNorm();
+          if (d < best_d2) {
+            best_d2 = d;
+            best = members_[m];
+          }
+        }
+      }
+  };
+  scan(lo, hi);
+  if (best_d2 > 0.25 * voxel_ * voxel_) {
+    int a[3], b[3];
+    for (int k = 0; k < 3; ++k) {
+      a[k] = std::max(0, c[k] - 1);
+      b[k] = std::min(dims_[k] - 1, c[k] + 1);
+    }
+    scan(a, b);  // the 2x2x2 again among the 27: cheaper than skipping them
+  }
+  *d2 = best_d2;
+  return best;
+}
+
+PreparedObject::Plane PreparedObject::fit(const Eigen::Vector3d& p, const RegistrationOptions& o) const {
+  int c[3];
+  if (!cellOf(p, c)) return {};
+  std::vector<std::pair<double, int>> near;
+  near.reserve(64);
+  for (int z = std::max(0, c[2] - 1); z <= std::min(dims_[2] - 1, c[2] + 1); ++z)
+    for (int y = std::max(0, c[1] - 1); y <= std::min(dims_[1] - 1, c[1] + 1); ++y) {
+      const long row = (static_cast<long>(z) * dims_[1] + y) * dims_[0];
+      for (int m = start_[row + std::max(0, c[0] - 1)]; m < start_[row + std::min(dims_[0] - 1, c[0] + 1) + 1]; ++m)
+        near.emplace_back((points_[members_[m]] - p).squaredNorm(), members_[m]);
+    }
+  const int k = std::min<int>(static_cast<int>(near.size()), o.plane_neighbours);
+  if (k < o.min_plane_points) return {};
+  std::nth_element(near.begin(), near.begin() + (k - 1), near.end());
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int i = 0; i < k; ++i) mean += points_[near[i].second];
+  mean /= k;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < k; ++i) {
+    const Eigen::Vector3d d = points_[near[i].second] - mean;
+    cov += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+  es.computeDirect(cov / k);
+  const Eigen::Vector3d ev = es.eigenvalues();  // ascending
+  // A plane: one small eigenvalue, two spread ones (a single scan ring is a line: no plane).
+  if (!(ev[1] > 1e-6) || ev[0] > o.max_planarity * ev[1]) return {};
+  return Plane{true, es.eigenvectors().col(0)};
+}
+
 RegistrationResult registerObject(const ObjectPoints& previous, const ObjectPoints& current, const Pose& prediction,
                                   double range, const RegistrationOptions& o) {
-  RegistrationResult result;
-  result.source_points = static_cast<int>(previous.size());
-  result.target_points = static_cast<int>(current.size());
-  result.motion = prediction;
   if (static_cast<int>(previous.size()) < o.min_points || static_cast<int>(current.size()) < o.min_points) {
+    RegistrationResult result;
+    result.source_points = static_cast<int>(previous.size());
+    result.target_points = static_cast<int>(current.size());
+    result.motion = prediction;
+    return result;  // kTooFewPoints
+  }
+  return registerObject(PreparedObject(previous, range, o), PreparedObject(current, range, o), prediction, o);
+}
+
+RegistrationResult registerObject(const PreparedObject& previous, const PreparedObject& current, const Pose& prediction,
+                                  const RegistrationOptions& o) {
+  RegistrationResult result;
+  result.source_points = previous.rawPoints();
+  result.target_points = current.rawPoints();
+  result.motion = prediction;
+  if (previous.rawPoints() < o.min_points || current.rawPoints() < o.min_points) {
     result.outcome = RegistrationOutcome::kTooFewPoints;
     return result;
   }
   // Centred on the current points' centroid: rotations turn about the object, so translation and
   // rotation separate in the Hessian (about the world origin 30 m away they would not).
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3f& p : current) c += p.cast<double>();
-  c /= static_cast<double>(current.size());
-  // A near car has thousands of points: both sides are thinned to one point per half voxel (and a
-  // bounded number), which bounds the work per object.
-  const double voxel = std::max(o.min_voxel, o.voxel_per_m * range);
-  const std::vector<Eigen::Vector3d> target = thin(current, c, 0.5 * voxel, o.max_target_points);
-  const std::vector<Eigen::Vector3d> source = thin(previous, c, 0.5 * voxel, o.max_source_points);
-  PlaneGrid grid(target, voxel, 2, o);
+  const Eigen::Vector3d c = current.centroid();
+  std::vector<Eigen::Vector3d> source = previous.sourcePoints();
+  for (Eigen::Vector3d& p : source) p -= c;
+  const std::vector<PreparedObject::Plane>& planes = previous.sourcePlanes();
+  const std::vector<Eigen::Vector3d>& target = current.points();
+  const double voxel = current.voxel();
 
   // M_c = T(-c) M T(c): q = R p + t in centred coordinates.
   Eigen::Matrix3d R = prediction.linear();
@@ -233,27 +247,31 @@ RegistrationResult registerObject(const ObjectPoints& previous, const ObjectPoin
     inliers = 0;
     wr2 = wsum = 0;
     for (size_t i = 0; i < source.size(); ++i) {
-      const Eigen::Vector3d& p = source[i];
-      const Eigen::Vector3d Rp = R * p;
+      if (!planes[i].valid) continue;
+      const Eigen::Vector3d Rp = R * source[i];
       const Eigen::Vector3d q = Rp + t;
       int j = match[i];
       if (it == 0 || (q - searched_at[i]).squaredNorm() > research2) {
         double d2;
-        j = grid.nearest(q, &d2);
+        j = current.nearest(q + c, &d2);
         if (j >= 0 && d2 > max_r2) j = -1;
         match[i] = j;
         searched_at[i] = q;
-      } else if (j >= 0 && (q - target[j]).squaredNorm() > max_r2) {
+      } else if (j >= 0 && (q + c - target[j]).squaredNorm() > max_r2) {
         j = -1;
       }
       if (j < 0) continue;
-      const PlaneGrid::Plane& plane = grid.plane(j);
-      if (!plane.valid) continue;
-      const double r = plane.normal.dot(q - target[j]);
+      // The previous point's plane, turned with it: r = (R n) . (R p + t - x).
+      const Eigen::Vector3d n = R * planes[i].normal;
+      const Eigen::Vector3d d = q + c - target[j];
+      const double r = n.dot(d);
       ++inliers;
       const double u = r / o.cauchy_scale, w = 1.0 / (1.0 + u * u);
       Vector6 J;
-      J << plane.normal, Rp.cross(plane.normal);
+      // The normal turns with the point too ((R n) x d), but d's part along the plane is the
+      // spacing of the current points, not a misalignment: left out, as in point-to-plane ICP.
+      J << n, Rp.cross(n);
+      if (o.planar) J.segment<3>(2).setZero();  // z, roll, pitch: not estimated, no information
       H.selfadjointView<Eigen::Lower>().rankUpdate(J, w);
       g += w * r * J;
       wr2 += w * r * r;

@@ -2,13 +2,24 @@
 // pose-change vertex c of eq. 10 directly): the object's points of the previous scan registered
 // to its points of the current scan, both in the world frame, from a predicted motion.
 //
-// Point-to-plane Gauss-Newton with Cauchy weights, centred on the object. The current points are
-// binned in a small dense voxel grid around the object: a previous point's nearest current point
-// is searched in its voxel's 3x3x3 neighbourhood, and that point's plane (its nearest neighbours
-// there) is fitted once and cached. Why not PCL's kd-tree (or GICP): k-nearest-neighbour normals
-// and a query per point and iteration cost about 1 ms a car, and 20 objects must fit in 3 ms a
-// frame (bench/object_registration_bench.cpp). The voxel grows with range, so a far object's
-// neighbourhood spans several scan rings (a single ring is a line, not a plane).
+// Point-to-plane Gauss-Newton with Cauchy weights, centred on the object. Each scan's points are
+// prepared once (prepareObject), in the frame they arrive: thinned to one point per half voxel,
+// binned in a small dense voxel grid (for the next frame's nearest-point searches, as the
+// target), and a subsample of them given the plane of their nearest neighbours (for the next
+// frame, as the source). A track's current scan is the next frame's previous one, so the
+// thinning and the plane fits are done once per scan, not once per registration: the planes are
+// the source's (the previous scan's), a previous point's nearest current point is searched in
+// its voxel's 3x3x3 neighbourhood. Why not PCL's VoxelGrid, kd-tree and normal estimation (or
+// GICP): on these clouds of a few hundred points they cost several times as much
+// (bench/object_registration_bench.cpp), and 20 objects must fit in 3 ms a frame. The voxel grows
+// with range, so a far object's neighbourhood spans several scan rings (a single ring is a line,
+// not a plane).
+//
+// The motion is measured in the ground plane (x, y, yaw; world z up): a car's faces are nearly
+// all vertical and its roof is seen at a grazing angle, so its height, roll and pitch were weakly
+// and unfaithfully measured (from an exact start the full 6-DoF fit drifted 0.1-0.7 m in height,
+// and a measurement that says so with confidence pulls the chain); they keep the prediction's
+// values and get no information.
 //
 // The result's information is the Gauss-Newton Hessian over the residuals' own variance (its
 // whitened, robust-weighted spread, floored by the sensor's noise), shrunk by
@@ -18,6 +29,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -33,12 +45,15 @@ struct RegistrationOptions {
   // that a neighbourhood of 3 voxels spans 2-3 scan rings of a 64-beam lidar (0.4 deg apart).
   double min_voxel = 0.25;
   double voxel_per_m = 0.012;
-  int plane_neighbours = 8;       // a current point's plane: its nearest this many points ...
+  int plane_neighbours = 8;       // a source point's plane: its nearest this many points ...
   int min_plane_points = 5;       // ... at least this many within a voxel's reach
   double max_planarity = 0.3;     // smallest / middle eigenvalue of those points: above, not a plane
   double cauchy_scale = 0.05;     // m: residuals beyond this are down-weighted (neighbours, ground)
+  // The motion in the ground plane only (x, y, yaw; above); false: all 6 directions.
+  bool planar = true;
   double max_residual = 0.3;      // m: correspondences beyond are not used
-  int max_iterations = 10;
+  // A start half a metre off needs 5 steps of max_step before the fine convergence.
+  int max_iterations = 15;
   double max_step = 0.1;          // m (and rad x 2 m): the largest step of one iteration
   double converged_step = 1e-3;   // m (and rad x 1 m): the step that ends the iterations
   double point_sigma = 0.02;      // m: floor of the residuals' standard deviation (sensor noise)
@@ -50,7 +65,7 @@ struct RegistrationOptions {
 };
 
 enum class RegistrationOutcome {
-  kMeasured,      // every direction measured
+  kMeasured,      // every direction measured (x, y and yaw when planar)
   kPartial,       // one horizontal translation direction unmeasured (e.g. a flat side edge-on)
   kTooFewPoints,
   kDegenerate,    // neither horizontal direction measured
@@ -75,8 +90,52 @@ struct RegistrationResult {
 
 using ObjectPoints = std::vector<Eigen::Vector3f>;
 
-// `previous` and `current`: the object's points of the two scans, world frame. `prediction`: the
-// predicted M. `range`: the object's distance from the sensor (m), which sets the voxel size.
+// One scan's points of an object, prepared for registration (world frame): as the target of
+// this frame's registration and as the source of the next frame's.
+class PreparedObject {
+ public:
+  struct Plane {
+    bool valid = false;
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  };
+
+  // `points`: the object's points of one scan, world frame; `range`: its distance from the sensor
+  // (m), which sets the voxel size.
+  PreparedObject(const ObjectPoints& points, double range, const RegistrationOptions& options);
+
+  int rawPoints() const { return raw_points_; }
+  double voxel() const { return voxel_; }
+  // Thinned to one point per half voxel, at most max_target_points.
+  const std::vector<Eigen::Vector3d>& points() const { return points_; }
+  const Eigen::Vector3d& centroid() const { return centroid_; }
+  // At most max_source_points of them, each with the plane of its nearest neighbours (invalid:
+  // none, or not flat).
+  const std::vector<Eigen::Vector3d>& sourcePoints() const { return source_; }
+  const std::vector<Plane>& sourcePlanes() const { return planes_; }
+  // The index of the point nearest to q within one voxel's reach (-1: none), and its squared distance.
+  int nearest(const Eigen::Vector3d& q, double* d2) const;
+
+ private:
+  bool cellOf(const Eigen::Vector3d& p, int* c) const;
+  Plane fit(const Eigen::Vector3d& p, const RegistrationOptions& options) const;
+
+  int raw_points_ = 0;
+  double voxel_ = 0;
+  std::vector<Eigen::Vector3d> points_;
+  Eigen::Vector3d centroid_ = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> source_;
+  std::vector<Plane> planes_;
+  // The points binned in a dense voxel grid: point indices per voxel (CSR).
+  Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
+  int dims_[3] = {0, 0, 0};
+  std::vector<int> start_, members_;
+};
+
+// `previous` and `current`: the object's prepared points of the two scans. `prediction`: the
+// predicted M.
+RegistrationResult registerObject(const PreparedObject& previous, const PreparedObject& current, const Pose& prediction,
+                                  const RegistrationOptions& options);
+// The same from the raw points (both prepared here, at the same range).
 RegistrationResult registerObject(const ObjectPoints& previous, const ObjectPoints& current, const Pose& prediction,
                                   double range, const RegistrationOptions& options);
 

@@ -231,12 +231,14 @@ bool SlidingWindow::registers(const std::string& type) const {
 
 void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, int frame, const Pose& X, BackendOutput& out) {
   if (!obs.points || !registers(track.type)) return;
-  auto world = std::make_shared<ObjectPoints>();
-  world->reserve(obs.points->size());
-  for (const Eigen::Vector3f& p : *obs.points) world->push_back((X * p.cast<double>()).cast<float>());
-  const std::shared_ptr<const ObjectPoints> previous = track.points;
+  ObjectPoints world;
+  world.reserve(obs.points->size());
+  for (const Eigen::Vector3f& p : *obs.points) world.push_back((X * p.cast<double>()).cast<float>());
+  const std::shared_ptr<const PreparedObject> previous = track.points;
   const int previous_frame = track.points_frame;
-  track.points = world;
+  // Prepared once: this frame's target, the next frame's source.
+  const auto current = std::make_shared<const PreparedObject>(world, obs.box.center.norm(), config_.registration);
+  track.points = current;
   track.points_frame = frame;
   if (!previous || previous_frame != frame - 1) {
     ++out.registration_no_previous;
@@ -256,7 +258,7 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
     M0.translation() = (X * track.observations.at(frame).b).translation() -
                        (fromBlock(prev_ego->pose->data()) * prev_obs->second.b).translation();
   }
-  const RegistrationResult r = registerObject(*previous, *world, M0, obs.box.center.norm(), config_.registration);
+  const RegistrationResult r = registerObject(*previous, *current, M0, config_.registration);
   ++out.registrations[static_cast<int>(r.outcome)];
   out.registration_points += r.source_points;
   if (r.ok()) out.registration_residual_sq += r.rms_residual * r.rms_residual;

@@ -74,9 +74,10 @@ class SlidingWindow {
     // chain to estimate it again (coasting, or about to leave).
     std::optional<Eigen::Vector3d> velocity;
     bool velocity_from_chain = false;
-    // Per-object registration: the object's points of its latest scan (world frame), and the
-    // motions measured between consecutive scans (frame t -> M of t-1 -> t, world frame).
-    std::shared_ptr<const ObjectPoints> points;
+    // Per-object registration: the object's points of its latest scan (world frame, prepared:
+    // the next frame's previous points), and the motions measured between consecutive scans
+    // (frame t -> M of t-1 -> t, world frame).
+    std::shared_ptr<const PreparedObject> points;
     int points_frame = -1;
     struct Motion {
       Pose M = Pose::Identity();

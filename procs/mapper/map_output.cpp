@@ -136,11 +136,16 @@ std::vector<std::string> writeMapOutputs(const std::string& dir, const Mapper& m
   eval::writeTrajectory((d / "trajectory_map_tum.txt").string(), t, eval::TrajectoryFormat::Tum);
   {
     std::ofstream kf(d / "map_keyframes.txt");
-    kf << "# frame kept_points removed_points, then T_map_lidar as 12 numbers (3x4 row-major)\n";
+    // 9 digits: the evaluation places each keyframe's points with these poses and finds the map's
+    // points among them (to a few mm at a kilometre).
+    kf.precision(9);
+    kf << "# frame kept_points removed_points, then T_map_lidar as 12 numbers (3x4 row-major), then the T_map_lidar "
+          "its points were inserted with (the grid they were counted on; differs after a loop correction)\n";
     for (const KeyframeRecord& k : mapper.keyframes()) {
       kf << k.frame << " " << k.kept << " " << k.removed;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 4; ++c) kf << " " << k.map.matrix()(r, c);
+      for (const Pose* T : {&k.map, &k.inserted})
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 4; ++c) kf << " " << T->matrix()(r, c);
       kf << "\n";
     }
     if (!kf) throw std::runtime_error((d / "map_keyframes.txt").string() + ": cannot write");

@@ -179,7 +179,7 @@ void Mapper::commit(Pending& p, const std::vector<MovingBox>& boxes) {
   const Pose T_map = mapFromWorld() * p.pose;
   const size_t fresh = map_.insert(id, T_map, kept);
   removed_.insert(id, T_map, gone);
-  keyframes_.push_back({p.frame, p.utime, p.pose, T_map, static_cast<int>(nk), static_cast<int>(ng)});
+  keyframes_.push_back({p.frame, p.utime, p.pose, T_map, static_cast<int>(nk), static_cast<int>(ng), T_map});
   keyframe_count_ = static_cast<int>(keyframes_.size());
   map_voxels_ = map_.size();
   removed_voxels_ = removed_.size();

@@ -52,6 +52,9 @@ struct KeyframeRecord {
   Pose odometry = Pose::Identity();  // T_world_lidar
   Pose map = Pose::Identity();       // T_map_lidar (loop-closed)
   int kept = 0, removed = 0;         // points
+  // T_map_lidar the keyframe's points were put in the map with: the voxel grid they were counted on
+  // (dlslot-eval --map counts the truth on it; a loop correction moves `map`, not this).
+  Pose inserted = Pose::Identity();
 };
 
 // What MAP_STATE reports, read while the keyframe thread works.

@@ -20,16 +20,16 @@ int32_t& VoxelMap::slot(int64_t cx, int64_t cy, int64_t cz) {
   return (*last_block_)[((cx & m) << (2 * kBlockBits)) | ((cy & m) << kBlockBits) | (cz & m)];
 }
 
-void VoxelMap::add(const Eigen::Vector3d& p, const Eigen::Vector3f& local, int keyframe, float intensity) {
+void VoxelMap::add(const Eigen::Vector3d& p, const Eigen::Vector3f& local, int keyframe, float intensity, bool keep) {
   const Eigen::Vector3d c = (p * inverse_voxel_).array().floor();
   const int64_t cx = static_cast<int64_t>(c.x()), cy = static_cast<int64_t>(c.y()), cz = static_cast<int64_t>(c.z());
   // A scan's consecutive points often share a voxel (near the sensor a 0.2 m cell holds several
   // points of a ring): only the first of a run looks the cell up.
-  if (cx == last_cell_[0] && cy == last_cell_[1] && cz == last_cell_[2]) return;
+  if (!keep && cx == last_cell_[0] && cy == last_cell_[1] && cz == last_cell_[2]) return;
   last_cell_ = {cx, cy, cz};
   int32_t& s = slot(cx, cy, cz);
-  if (s >= 0) return;  // the voxel's first point stands for it
-  s = static_cast<int32_t>(voxels_.size());
+  if (s >= 0 && !keep) return;  // the voxel's first point stands for it
+  if (s < 0) s = static_cast<int32_t>(voxels_.size());
   voxels_.push_back(Voxel{local, keyframe, intensity});
 }
 
@@ -56,7 +56,7 @@ void VoxelMap::repose(const std::vector<Pose>& T_map_keyframe) {
   last_cell_ = {kNoCell, kNoCell, kNoCell};
   for (size_t k = 0; k < poses_.size() && k < T_map_keyframe.size(); ++k) poses_[k] = T_map_keyframe[k];
   voxels_.reserve(old.size());
-  for (const Voxel& v : old) add(poses_.at(v.keyframe) * v.local.cast<double>(), v.local, v.keyframe, v.intensity);
+  for (const Voxel& v : old) add(poses_.at(v.keyframe) * v.local.cast<double>(), v.local, v.keyframe, v.intensity, true);
 }
 
 PointCloud VoxelMap::cloud() const {

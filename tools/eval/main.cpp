@@ -217,9 +217,10 @@ void addProcessNotes(const RunLog& log, RunData& run) {
   }
 }
 
-// The mapper's keyframes (map_keyframes.txt: frame, kept, removed, T_map_lidar 3x4) or accepted
+// The mapper's keyframes (map_keyframes.txt: frame, kept, removed, T_map_lidar 3x4, T_map_lidar at
+// insertion 3x4) or accepted
 // loops (map_loops.txt: query, match, accepted, ..., T_match_query 3x4).
-std::vector<std::vector<double>> readNumberRows(const std::string& path, size_t min_fields) {
+std::vector<std::vector<double>> readNumberRows(const std::string& path, size_t min_fields, size_t max_fields = 18) {
   std::ifstream in(path);
   if (!in) throw InputError(path, 0, "cannot open");
   std::vector<std::vector<double>> rows;
@@ -229,7 +230,7 @@ std::vector<std::vector<double>> readNumberRows(const std::string& path, size_t 
     std::istringstream ls(line);
     std::vector<double> v;
     double x;
-    while (v.size() < 18 && ls >> x) v.push_back(x);
+    while (v.size() < max_fields && ls >> x) v.push_back(x);
     if (v.size() < min_fields || !std::all_of(v.begin(), v.end(), [](double d) { return std::isfinite(d); }))
       throw InputError(path, n, "expected at least " + std::to_string(min_fields) + " finite numbers");
     rows.push_back(std::move(v));
@@ -288,7 +289,7 @@ void addMap(const Options& o, const DataSet& data, RunData& run) {
   PointCloud map_points(4, static_cast<Eigen::Index>(cloud.size()));
   for (size_t i = 0; i < cloud.size(); ++i) map_points.col(static_cast<Eigen::Index>(i)) << cloud[i].x, cloud[i].y, cloud[i].z, cloud[i].intensity;
   mm.map_points = static_cast<int64_t>(cloud.size());
-  const auto keyframe_rows = readNumberRows((dir / "map_keyframes.txt").string(), 15);
+  const auto keyframe_rows = readNumberRows((dir / "map_keyframes.txt").string(), 15, 27);
   mm.keyframes = static_cast<int>(keyframe_rows.size());
   MapTruthOptions opt;
   {
@@ -326,6 +327,7 @@ void addMap(const Options& o, const DataSet& data, RunData& run) {
         k.frame = static_cast<int>(r[0]);
         if (k.frame < 0 || k.frame >= reader.size()) throw InputError((dir / "map_keyframes.txt").string(), 0, "frame outside the sequence");
         k.T_map_lidar = poseFrom12(r, 3);
+        if (r.size() >= 27) k.T_grid_lidar = poseFrom12(r, 15);  // the pose its points were inserted with
         const Frame f = reader.read(k.frame);
         k.scan = f.scan;
         k.labels = movingLabels(labels, k.frame, o.frame_period);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -52,21 +53,51 @@ std::vector<MovingBox> movingLabels(const std::map<int, std::vector<Box>>& label
 
 MapScore scoreMap(const PointCloud& map_points, const std::vector<MapKeyframe>& keyframes, const std::set<int>& moving,
                   const MapTruthOptions& o) {
+  if (!(o.coincidence_m > 0 && o.coincidence_m < 0.5 * o.voxel_m))
+    throw std::invalid_argument("scoreMap: coincidence_m must lie in (0, voxel_m / 2)");
   MapScore s;
   s.voxel_m = o.voxel_m;
-  std::unordered_set<uint64_t> occupied;
-  occupied.reserve(map_points.cols());
-  for (Eigen::Index i = 0; i < map_points.cols(); ++i) occupied.insert(voxelKey(map_points.col(i).head<3>().cast<double>(), o.voxel_m));
-  std::unordered_map<uint64_t, std::pair<int, int>> votes;  // voxel -> (static, dynamic) points
+  // The map's points by voxel of the map's (final) placement, to find them among the truth's.
+  std::unordered_map<uint64_t, std::vector<Eigen::Vector3d>> map_cells;
+  map_cells.reserve(map_points.cols());
+  for (Eigen::Index i = 0; i < map_points.cols(); ++i) {
+    const Eigen::Vector3d m = map_points.col(i).head<3>().cast<double>();
+    map_cells[voxelKey(m, o.voxel_m)].push_back(m);
+  }
+  const double e = o.coincidence_m, e2 = e * e;
+  // Whether q (a truth point where the map's poses put it) is one of the map's points: the cells
+  // the cube of half-side e around q touches (one, or two by an axis near a cell's face).
+  const auto inMap = [&](const Eigen::Vector3d& q) {
+    const Eigen::Vector3d lo_cell = ((q.array() - e) / o.voxel_m).floor(), hi_cell = ((q.array() + e) / o.voxel_m).floor();
+    for (double x = lo_cell.x(); x <= hi_cell.x(); ++x)
+      for (double y = lo_cell.y(); y <= hi_cell.y(); ++y)
+        for (double z = lo_cell.z(); z <= hi_cell.z(); ++z) {
+          const auto it = map_cells.find(voxelKey((Eigen::Vector3d(x, y, z).array() + 0.5) * o.voxel_m, o.voxel_m));
+          if (it == map_cells.end()) continue;
+          for (const Eigen::Vector3d& m : it->second)
+            if ((m - q).squaredNorm() <= e2) return true;
+        }
+    return false;
+  };
+  struct Votes {
+    int static_points = 0, dynamic_points = 0;
+  };
+  std::unordered_map<uint64_t, Votes> votes;
+  std::unordered_set<uint64_t> held;  // grid voxels one of whose points is in the map
   const double lo = o.min_range_m * o.min_range_m, hi = o.max_range_m * o.max_range_m;
   for (const MapKeyframe& kf : keyframes) {
+    const Pose& T_grid = kf.T_grid_lidar ? *kf.T_grid_lidar : kf.T_map_lidar;
     std::vector<const MovingBox*> boxes;
     for (const MovingBox& b : kf.labels)
       if (moving.count(b.box.id)) boxes.push_back(&b);
     for (Eigen::Index i = 0; i < kf.scan.cols(); ++i) {
       const Eigen::Vector3d p = kf.scan.col(i).head<3>().cast<double>();
-      const double r2 = p.squaredNorm();
-      if (r2 < lo || r2 > hi) continue;
+      const double d2 = p.squaredNorm();
+      if (d2 < lo || d2 > hi) continue;
+      // Whether the voxel is held is asked of every point the mapper looked at, scored or not
+      // (a voxel's map point may be one outside the camera's view or in a DontCare box).
+      const uint64_t key = voxelKey(T_grid * p, o.voxel_m);
+      if (!held.count(key) && inMap(kf.T_map_lidar * p)) held.insert(key);
       if (o.T_cam_lidar) {
         const Eigen::Vector3d c = *o.T_cam_lidar * p;  // camera: z forward, x right
         if (c.z() <= 0 || std::abs(std::atan2(c.x(), c.z())) > o.camera_half_fov_rad) continue;
@@ -86,13 +117,13 @@ MapScore scoreMap(const PointCloud& map_points, const std::vector<MapKeyframe>& 
         }
       }
       if (band) continue;
-      auto& v = votes[voxelKey(kf.T_map_lidar * p, o.voxel_m)];
-      (dynamic ? v.second : v.first) += 1;
+      Votes& v = votes[key];
+      (dynamic ? v.dynamic_points : v.static_points) += 1;
     }
   }
   for (const auto& [key, v] : votes) {
-    const bool kept = occupied.count(key) > 0;
-    if (v.second > v.first) {
+    const bool kept = held.count(key) > 0;
+    if (v.dynamic_points > v.static_points) {
       ++s.dynamic_voxels;
       s.dynamic_removed += !kept;
     } else {

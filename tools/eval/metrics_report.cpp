@@ -400,7 +400,7 @@ std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plo
   }
   if (m.map) {
     const MapScore& s = m.map->score;
-    out << "## Static map (dlslot-mapper; dynamic-map benchmark terms on a " << s.voxel_m << " m voxel grid)\n\n";
+    out << "## Static map (dlslot-mapper; dynamic-map benchmark terms on a " << s.voxel_m << " m voxel grid, the grid the map counted its points on)\n\n";
     Table t({"AA", "SA", "DA", "static voxels", "dynamic voxels", "keyframes", "map points", "loops accepted",
              "false loops"});
     t.row({cell(s.aa, "%.4f"), cell(s.sa, "%.4f"), cell(s.da, "%.4f"), std::to_string(s.static_voxels),

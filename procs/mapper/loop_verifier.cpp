@@ -29,10 +29,17 @@ Cloud::Ptr toPcl(const PointCloud& points) {
   return c;
 }
 
-// Overlap of the query's structure with the match after T_match_query.
+// Overlap of the query's structure with the match after T_match_query: of the query's structure
+// points near the match keyframe that lie where the match side saw something (a match point
+// within support_m), the share within inlier_m of the match. The match side sees only part of what
+// the query sees (a place passed again 35 m off: other faces, other gaps between buildings), and
+// how much varies from place to place, so the share of all of the query's points says as much
+// about that as about the alignment; among the points the match side saw, a right pose puts most
+// on its surfaces, a wrong one about inlier_m / support_m of them (their distances to the nearest
+// surface spread evenly up to support_m).
 void score(const PointCloud& query, const pcl::KdTreeFLANN<pcl::PointXYZ>& tree, const Pose& T, double inlier_m,
-           double radius_m, Registration& r) {
-  int structure = 0, inliers = 0;
+           double support_m, double radius_m, Registration& r) {
+  int structure = 0, supported = 0, inliers = 0;
   double sq = 0;
   std::vector<int> index(1);
   std::vector<float> d2(1);
@@ -41,12 +48,16 @@ void score(const PointCloud& query, const pcl::KdTreeFLANN<pcl::PointXYZ>& tree,
     const Eigen::Vector3d p = T * query.col(i).head<3>().cast<double>();
     if (p.head<2>().norm() > radius_m) continue;  // where the match side sees densely
     ++structure;
-    if (tree.nearestKSearch(pcl::PointXYZ(p.x(), p.y(), p.z()), 1, index, d2) == 1 && d2[0] <= inlier_m * inlier_m) {
+    if (tree.nearestKSearch(pcl::PointXYZ(p.x(), p.y(), p.z()), 1, index, d2) != 1 || d2[0] > support_m * support_m)
+      continue;
+    ++supported;
+    if (d2[0] <= inlier_m * inlier_m) {
       ++inliers;
       sq += d2[0];
     }
   }
-  r.inlier_ratio = structure ? double(inliers) / structure : 0.0;
+  r.inlier_ratio = supported ? double(inliers) / supported : 0.0;
+  r.support_ratio = structure ? double(supported) / structure : 0.0;
   r.rmse_m = inliers ? std::sqrt(sq / inliers) : 0.0;
 }
 
@@ -73,7 +84,7 @@ Registration align(const Cloud::Ptr& query, const Cloud::Ptr& match, const Point
   r.converged = converged;
   r.T_match_query.matrix() = T.cast<double>();
   r.T_match_query.linear() = Eigen::Quaterniond(r.T_match_query.rotation()).normalized().toRotationMatrix();
-  score(query_points, tree, r.T_match_query, c.inlier_distance_m, c.overlap_radius_m, r);
+  score(query_points, tree, r.T_match_query, c.inlier_distance_m, c.support_distance_m, c.overlap_radius_m, r);
   return r;
 }
 
@@ -107,8 +118,8 @@ LoopVerdict verifyLoop(const PointCloud& query, const PointCloud& match, const P
   }
   if (best.inlier_ratio < c.min_inlier_ratio || best.rmse_m > c.max_rmse_m) {
     why.precision(3);
-    why << "overlap: inlier ratio " << best.inlier_ratio << " (min " << c.min_inlier_ratio << "), rmse "
-        << best.rmse_m << " m (max " << c.max_rmse_m << ")";
+    why << "overlap: inlier ratio " << best.inlier_ratio << " (min " << c.min_inlier_ratio << ") of the "
+        << best.support_ratio << " the match side saw, rmse " << best.rmse_m << " m (max " << c.max_rmse_m << ")";
     v.reason = why.str();
     return v;
   }

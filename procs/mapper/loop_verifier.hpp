@@ -1,10 +1,11 @@
 // Verifying a loop candidate: the two keyframes' clouds registered (PCL's generalized ICP,
 // Segal et al. 2009), then a strict acceptance test. A false loop bends the whole trajectory, a
 // missed one only leaves drift, so a candidate must pass all of:
-//   1. overlap: most of the query's structure (points off the ground) that falls within
-//      overlap_radius_m of the match keyframe (where the match side sees densely: a place passed
-//      again tens of metres away overlaps only there) lies within inlier_distance of the match
-//      after alignment, with a small RMS distance;
+//   1. overlap: of the query's structure (points off the ground) within overlap_radius_m of the
+//      match keyframe (where the match side sees densely: a place passed again tens of metres away
+//      overlaps only there) and where the match side saw something (a match point within
+//      support_distance_m), most lies within inlier_distance of the match after alignment, with a
+//      small RMS distance (a wrong pose: about inlier / support distance of it, by chance);
 //   2. drift bound: the registration moves the query at most 1 m + max_drift_fraction x the path
 //      driven since the match (and 2 deg + 1 deg per 100 m) away from where the odometry puts it:
 //      anything farther is not drift but a wrong place;
@@ -24,7 +25,11 @@ namespace dlslot::mapper {
 struct Registration {
   Pose T_match_query = Pose::Identity();
   bool converged = false;
-  double inlier_ratio = 0;  // share of the query's points off the ground within inlier_distance
+  // Of the query's points off the ground near the match keyframe, the share where the match side saw
+  // something (a match point within support_distance) ...
+  double support_ratio = 0;
+  // ... and of those, the share within inlier_distance of the match.
+  double inlier_ratio = 0;
   double rmse_m = 0;        // RMS distance of those inliers
 };
 

@@ -72,6 +72,7 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
   l.get("submap_keyframes", L.submap_keyframes);
   l.get("overlap_radius_m", L.overlap_radius_m);
   l.get("inlier_distance_m", L.inlier_distance_m);
+  l.get("support_distance_m", L.support_distance_m);
   l.get("min_inlier_ratio", L.min_inlier_ratio);
   l.get("max_rmse_m", L.max_rmse_m);
   l.get("max_drift_fraction", L.max_drift_fraction);
@@ -92,6 +93,7 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
                              {"max_correspondence_m", L.max_correspondence_m},
                              {"fine_correspondence_m", L.fine_correspondence_m},
                              {"inlier_distance_m", L.inlier_distance_m},
+                             {"support_distance_m", L.support_distance_m},
                              {"overlap_radius_m", L.overlap_radius_m},
                              {"min_inlier_ratio", L.min_inlier_ratio},
                              {"max_rmse_m", L.max_rmse_m},
@@ -102,6 +104,8 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
                              {"loop_sigma_t", L.loop_sigma_t},
                              {"loop_sigma_r", L.loop_sigma_r}})
     positive(l, k, v);
+  if (!(L.support_distance_m > L.inlier_distance_m))
+    throw ConfigError(l.file() + ": mapper.loop.support_distance_m: expected > inlier_distance_m");
   if (!(L.min_separation_m >= 0 && L.max_drift_fraction >= 0))
     throw ConfigError(l.file() + ": mapper.loop: min_separation_m and max_drift_fraction: expected >= 0");
   l.finish();

@@ -18,7 +18,7 @@ struct LoopConfig {
          fine_correspondence_m = 0.6;
   int submap_keyframes = 10;  // the match side of a verification: the candidate and this many keyframes either side
   double overlap_radius_m = 30.0;
-  double inlier_distance_m = 0.3, min_inlier_ratio = 0.4, max_rmse_m = 0.25;
+  double inlier_distance_m = 0.3, support_distance_m = 1.0, min_inlier_ratio = 0.5, max_rmse_m = 0.25;
   double max_drift_fraction = 0.03;
   double ambiguity_shift_m = 4.0, ambiguity_ratio = 0.9;
   double odometry_sigma_t = 0.02, odometry_sigma_r = 0.002;

@@ -89,6 +89,7 @@ TEST(MessageGuard, LayoutWalkConsumesExactlyWhatLcmGenEncodes) {
   status.counter_values = {1, 2};
   status.num_counters = 2;
   expectLayoutMatches(status);
+  expectLayoutMatches(sampleMapState(4, /*with_loops=*/true));
 }
 
 TEST(MessageGuard, CountsAndStringLengthsAreCheckedBeforeLcmGenAllocates) {
@@ -100,6 +101,7 @@ TEST(MessageGuard, CountsAndStringLengthsAreCheckedBeforeLcmGenAllocates) {
   expectStructuralRefusals(sampleAssociations(4), kAssociationsStringAt, 8);
   expectStructuralRefusals(sampleSlotState(4), kSlotStringAt, 4, slotStateTimingsCountAt(encode(sampleSlotState(4))));
   expectStructuralRefusals(sampleStatus(), kStatusStringAt, 8);
+  expectStructuralRefusals(sampleMapState(4), 0, 0);
   // A NUL inside a string, or none at its end (lcm-gen would not encode it back).
   Bytes b = encode(sampleScan(4));
   b[kScanStringAt + 4 + 1] = 0;
@@ -118,6 +120,7 @@ TEST(MessageGuard, FramesOutsideTheSequenceRangeAreRefused) {
   expectFrameRefusals(sampleOdometry(4));
   expectFrameRefusals(sampleAssociations(4));
   expectFrameRefusals(sampleSlotState(4));
+  expectFrameRefusals(sampleMapState(4, true));
   EXPECT_EQ(check<odometry_t>(encode(sampleOdometry(-1))).reason, "frame_range");
   EXPECT_FALSE(check<odometry_t>(encode(sampleOdometry(kMaxFrame))));
 }
@@ -128,6 +131,21 @@ TEST(MessageGuard, WellFormedLiesAreRefused) {
   EXPECT_EQ(check<slot_state_t>(nanPose(encode(sampleSlotState(2)), kSlotPoseAt).bytes).reason, "non_finite");
   EXPECT_EQ(check<associations_t>(nanPose(encode(sampleAssociations(2)), kAssociationsPoseAt).bytes).reason, "non_finite");
   EXPECT_EQ(check<ground_truth_t>(nanPose(encode(sampleGroundTruth(2)), kGroundTruthPoseAt).bytes).reason, "non_finite");
+  EXPECT_EQ(check<map_state_t>(nanPose(encode(sampleMapState(2)), kMapStatePoseAt).bytes).reason, "non_finite");
+  // A loop must join this scan or an earlier one to an older one; its scores are finite and >= 0.
+  map_state_t map = sampleMapState(5, true);
+  EXPECT_FALSE(check<map_state_t>(encode(map)));
+  map.loops[0].match_frame = 5;
+  EXPECT_EQ(check<map_state_t>(encode(map)).reason, "frame_range");
+  map = sampleMapState(5, true);
+  map.loops[1].query_frame = 6;
+  EXPECT_EQ(check<map_state_t>(encode(map)).reason, "frame_range");
+  map = sampleMapState(5, true);
+  map.loops[1].inlier_ratio = nan;
+  EXPECT_EQ(check<map_state_t>(encode(map)).reason, "bad_value");
+  map = sampleMapState(5, true);
+  map.keyframes = -1;
+  EXPECT_EQ(check<map_state_t>(encode(map)).reason, "bad_value");
 
   odometry_t odo = sampleOdometry(2);
   odo.pose.orientation[0] = 0;  // not a rotation

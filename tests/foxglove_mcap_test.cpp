@@ -481,11 +481,27 @@ SyntheticRun writeLog(const std::string& path) {
       run.utimes["PROCESS_STATUS"].push_back(ps.utime);
       ++run.statuses;
     }
+    // The mapper's state: the correction 0.5 m in x from frame 6 on, and at the last frame a loop
+    // from it back to frame 1 (accepted) and one refused.
+    map_state_t ms{};
+    ms.utime = s.utime, ms.frame = f;
+    ms.map_from_world = poseAt(f >= 6 ? 0.5 : 0.0, 0);
+    ms.map_pose = poseAt(f + (f >= 6 ? 0.5 : 0.0), 0);
+    if (f == 11) {
+      loop_event_t e{};
+      e.query_frame = 11, e.match_frame = 1, e.relative = poseAt(0.2, 0), e.accepted = true;
+      loop_event_t refused = e;
+      refused.match_frame = 2, refused.accepted = false, refused.reason = "overlap";
+      ms.loops = {e, refused};
+      ms.num_loops = 2;
+    }
+    put("MAP_STATE", ms);
+    run.utimes["MAP_STATE"].push_back(s.utime);
     if (f % 3 == 0) {
       lcm::LogEvent ev{};
       uint8_t bytes[20] = {0xde, 0xad, 0xbe, 0xef};
       ev.timestamp = t += 1000;
-      ev.channel = "MAP_STATE";
+      ev.channel = "USER_NOTES";
       ev.datalen = sizeof bytes;
       ev.data = bytes;
       log.writeEvent(&ev);
@@ -520,10 +536,13 @@ TEST(McapExport, EveryChannelReadsBackInAnIndependentReaderWithTheLogsCountsAndT
       {"/tf", {"foxglove.FrameTransform", "SLOT_STATE"}},
       {"/slot/path", {"foxglove.PosesInFrame", "SLOT_STATE"}},
       {"/slot/tracks", {"foxglove.SceneUpdate", "SLOT_STATE"}},
+      {"/map/tf", {"foxglove.FrameTransform", "MAP_STATE"}},
+      {"/map/path", {"foxglove.PosesInFrame", "MAP_STATE"}},
+      {"/map/loops", {"foxglove.SceneUpdate", "MAP_STATE"}},
       {"/process_status", {"dlslot.ProcessStatus", "PROCESS_STATUS"}},
   };
   const YAML::Node topics = r["topics"];
-  EXPECT_EQ(topics.size(), expected.size() + 1);  // + /lcm/MAP_STATE
+  EXPECT_EQ(topics.size(), expected.size() + 1);  // + /lcm/USER_NOTES
   int64_t total = 0;
   for (const auto& [topic, want] : expected) {
     SCOPED_TRACE(topic);
@@ -543,8 +562,8 @@ TEST(McapExport, EveryChannelReadsBackInAnIndependentReaderWithTheLogsCountsAndT
     for (size_t i = 0; i < utimes.size(); ++i)
       EXPECT_EQ(t["timestamps"][i].as<std::string>(), std::to_string(utimes[i] * 1000)) << "message " << i;
   }
-  EXPECT_EQ(topics["/lcm/MAP_STATE"]["streamed"].as<int>(), run.raw);
-  EXPECT_EQ(topics["/lcm/MAP_STATE"]["schemaName"].as<std::string>(), "dlslot.LcmMessage");
+  EXPECT_EQ(topics["/lcm/USER_NOTES"]["streamed"].as<int>(), run.raw);
+  EXPECT_EQ(topics["/lcm/USER_NOTES"]["schemaName"].as<std::string>(), "dlslot.LcmMessage");
   EXPECT_EQ(r["messageCount"].as<int64_t>(), total + run.raw);
   // Every message of a scan shares that scan's log time: the scan's points, boxes and poses
   // show together when Foxglove scrubs.
@@ -558,6 +577,18 @@ TEST(McapExport, EveryChannelReadsBackInAnIndependentReaderWithTheLogsCountsAndT
   EXPECT_EQ(topics["/slot/tracks"]["details"][11]["lines"].as<int>(), 2);
   EXPECT_EQ(topics["/ground_truth/path"]["details"][11]["poses"].as<int>(), 12);
   EXPECT_EQ(topics["/tf"]["details"][0]["child"].as<std::string>(), "lidar");
+  // The mapper's frame: "world" placed in "map" by the correction, the loop-closed path in "map",
+  // and the accepted loop (not the refused one) as a line once it is there.
+  EXPECT_EQ(topics["/map/tf"]["details"][11]["parent"].as<std::string>(), "map");
+  EXPECT_EQ(topics["/map/tf"]["details"][11]["child"].as<std::string>(), "world");
+  EXPECT_DOUBLE_EQ(topics["/map/tf"]["details"][5]["t"][0].as<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(topics["/map/tf"]["details"][6]["t"][0].as<double>(), 0.5);
+  EXPECT_EQ(topics["/map/path"]["details"][11]["poses"].as<int>(), 12);
+  EXPECT_EQ(topics["/map/path"]["details"][11]["frame"].as<std::string>(), "map");
+  EXPECT_EQ(topics["/map/loops"]["details"][10]["entities"].as<int>(), 0);
+  EXPECT_EQ(topics["/map/loops"]["details"][11]["entities"].as<int>(), 1);
+  EXPECT_EQ(topics["/map/loops"]["details"][11]["lines"].as<int>(), 1);
+  EXPECT_EQ(topics["/map/loops"]["details"][11]["texts"][0].as<std::string>(), "loop 11 -> 1");
 }
 
 TEST(McapExport, ACorruptLogIsAnErrorNamingTheFile) {

@@ -167,6 +167,37 @@ inline slot_state_t sampleSlotState(int frame) {
 }
 constexpr size_t kSlotStringAt = 20, kSlotPoseAt = 20 + 4 + 5;
 
+// A MAP_STATE without loop events (num_loops, the last field, 0), or with an accepted loop from
+// `frame` to frame 0 and a refused one.
+inline map_state_t sampleMapState(int frame, bool with_loops = false) {
+  map_state_t m{};
+  m.utime = 1000 + frame;
+  m.frame = frame;
+  m.map_from_world = samplePose(0.5);
+  m.map_pose = samplePose(frame);
+  m.keyframes = 3;
+  m.map_points = 1000;
+  if (with_loops) {
+    loop_event_t accepted{};
+    accepted.query_frame = frame;
+    accepted.match_frame = 0;
+    accepted.relative = samplePose(0.2);
+    accepted.descriptor_distance = 0.2;
+    accepted.inlier_ratio = 0.6;
+    accepted.rmse_m = 0.15;
+    accepted.accepted = true;
+    loop_event_t refused = accepted;
+    refused.accepted = false;
+    refused.reason = "overlap";
+    m.loops = {accepted, refused};
+    m.loops_accepted = 1;
+    m.loops_rejected = 1;
+  }
+  m.num_loops = static_cast<int32_t>(m.loops.size());
+  return m;
+}
+constexpr size_t kMapStatePoseAt = 20;
+
 inline process_status_t sampleStatus() {
   process_status_t m{};
   m.utime = 1000;

@@ -152,11 +152,13 @@ void Channels::read(ConfigSection s) {
   s.get("associations", associations);
   s.get("slot_state", slot_state);
   s.get("status", status);
+  // Optional (their defaults): configs written before the mapper and the player's events still load.
+  if (s.has("map_state")) s.get("map_state", map_state);
   if (s.has("run_event")) s.get("run_event", run_event);
   const std::pair<const char*, const std::string*> all[] = {
       {"scan", &scan},           {"detections", &detections}, {"ground_truth", &ground_truth},
       {"odometry", &odometry},   {"associations", &associations}, {"slot_state", &slot_state},
-      {"status", &status},       {"run_event", &run_event}};
+      {"status", &status},       {"map_state", &map_state}, {"run_event", &run_event}};
   for (size_t i = 0; i < std::size(all); ++i) {
     if (all[i].second->empty())
       throw ConfigError(s.file() + ": " + s.path() + "." + all[i].first + ": expected a channel name, got ''");

@@ -16,6 +16,7 @@ constexpr size_t kMinString = kI32 + 1;  // length (>= 1) and the terminating NU
 constexpr size_t kMinBox = kMinString + kI32 + 8 * kF64;
 constexpr size_t kMinTiming = kMinString + kF64;
 constexpr size_t kMinTrack = kI32 + kMinString + kPose + 9 * kF64 + kI8 + 36 * kF64 + 3 * kI32 + kI8 + kF64;
+constexpr size_t kMinLoopEvent = 2 * kI32 + kPose + 3 * kF64 + kI8 + kMinString;
 constexpr size_t kMinAssociation = 3 * kI32 + kI8 + 2 * kMinBox + kI8 + 3 * kF64 + kI8 + kF64 + kI8 + kF64;
 
 class Cursor {
@@ -290,6 +291,17 @@ Refusal checkLayout(const run_event_t*, const void* data, size_t size) {
   return c.finish();
 }
 
+Refusal checkLayout(const map_state_t*, const void* data, size_t size) {
+  Cursor c(data, size);
+  int32_t n = 0;
+  bool ok = header(c, map_state_t::getHash()) && pose(c, "map_from_world") && pose(c, "map_pose") &&
+            c.skip(5 * kI32, "keyframes .. loops_rejected") && c.count(&n, kMinLoopEvent, "num_loops");
+  for (int32_t i = 0; ok && i < n; ++i)
+    ok = c.skip(2 * kI32, "loops.frames") && pose(c, "loops.relative") && c.skip(3 * kF64 + kI8, "loops.scores") &&
+         c.str("loops.reason");
+  return c.finish();
+}
+
 // ---------------- contents ----------------
 
 Refusal checkContent(const point_cloud_t& m) {
@@ -407,6 +419,35 @@ Refusal checkContent(const slot_state_t& m) {
   if (!std::isfinite(m.odometry_inflation)) return nonFinite("odometry_inflation");
   if (Refusal r = checkNonNegative(m.odometry_support, "odometry_support")) return r;
   return checkTimings(m.timings);
+}
+
+Refusal checkContent(const map_state_t& m) {
+  if (Refusal r = checkFrame(m.frame)) return r;
+  if (Refusal r = checkUtime(m.utime)) return r;
+  if (Refusal r = checkPose(m.map_from_world, "map_from_world")) return r;
+  if (Refusal r = checkPose(m.map_pose, "map_pose")) return r;
+  const std::pair<int64_t, const char*> counts[] = {{m.keyframes, "keyframes"},
+                                                    {m.map_points, "map_points"},
+                                                    {m.removed_points, "removed_points"},
+                                                    {m.loops_accepted, "loops_accepted"},
+                                                    {m.loops_rejected, "loops_rejected"}};
+  for (const auto& [value, field] : counts)
+    if (Refusal r = checkNonNegative(value, field)) return r;
+  for (size_t i = 0; i < m.loops.size(); ++i) {
+    const loop_event_t& e = m.loops[i];
+    const std::string f = fieldAt("loops", i);
+    // A loop joins a scan of this frame or before to an older one.
+    if (e.query_frame < 0 || e.query_frame > m.frame || e.match_frame < 0 || e.match_frame >= e.query_frame)
+      return {"frame_range", f + ": match_frame " + std::to_string(e.match_frame) + ", query_frame " +
+                                 std::to_string(e.query_frame) + ", expected 0 <= match < query <= frame " +
+                                 std::to_string(m.frame)};
+    if (Refusal r = checkPose(e.relative, f + ".relative")) return r;
+    const std::pair<double, const char*> scores[] = {
+        {e.descriptor_distance, ".descriptor_distance"}, {e.inlier_ratio, ".inlier_ratio"}, {e.rmse_m, ".rmse_m"}};
+    for (const auto& [value, field] : scores)
+      if (!std::isfinite(value) || value < 0) return {"bad_value", f + field + " = " + std::to_string(value) + ", expected finite >= 0"};
+  }
+  return {};
 }
 
 Refusal checkContent(const process_status_t& m) {

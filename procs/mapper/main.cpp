@@ -177,7 +177,7 @@ int runLive(const MapperConfig& config, const Channels& channels, const NodeOpti
         const int64_t utime = j.b->utime;
         feed(mapper, j);
         reportWorkers(mapper, node.status(), channels.scan);
-        node.publish(config.channel, mapStateMsg(mapper, j.frame, utime, slot_pose, mapper.loops().takeEvents()));
+        node.publish(channels.map_state, mapStateMsg(mapper, j.frame, utime, slot_pose, mapper.loops().takeEvents()));
         node.status().frameDone(j.frame, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         const MapperSnapshot now = mapper.snapshot();
         node.status().set("keyframes", now.keyframes);

@@ -11,8 +11,6 @@ void positive(const ConfigSection& s, const std::string& key, double v) {
 
 MapperConfig MapperConfig::read(ConfigSection& s) {
   MapperConfig c;
-  s.get("channel", c.channel);
-  if (c.channel.empty()) throw ConfigError(s.file() + ": " + s.path() + ".channel: expected a channel name");
   s.get("keyframe_distance_m", c.keyframe_distance_m);
   s.get("keyframe_angle_deg", c.keyframe_angle_deg);
   s.get("min_range_m", c.min_range_m);

@@ -26,7 +26,6 @@ struct LoopConfig {
 };
 
 struct MapperConfig {
-  std::string channel = "MAP_STATE";
   double keyframe_distance_m = 1.0, keyframe_angle_deg = 10.0;
   double min_range_m = 2.5, max_range_m = 50.0;
   double map_voxel_m = 0.2;

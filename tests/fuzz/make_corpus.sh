@@ -11,7 +11,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 "$ROOT/scripts/launch" dlslot-run --scenario intersection --frames 6 --out "$work/run" --no-render --quiet >/dev/null
 rm -rf "$C"
-for t in point_cloud_t detections_t ground_truth_t odometry_t associations_t slot_state_t process_status_t run_event_t; do
+for t in point_cloud_t detections_t ground_truth_t odometry_t associations_t slot_state_t process_status_t run_event_t map_state_t; do
   mkdir -p "$C/fuzz_msg_$t"
 done
 for r in labels csv_detections poses oxts calib times velodyne config tum run_log; do mkdir -p "$C/fuzz_file_$r"; done

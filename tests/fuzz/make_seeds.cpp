@@ -49,7 +49,7 @@ int main(int argc, char** argv) {
   const std::map<std::string, std::string> target = {
       {ch.scan, "point_cloud_t"},   {ch.detections, "detections_t"},     {ch.ground_truth, "ground_truth_t"},
       {ch.odometry, "odometry_t"},  {ch.associations, "associations_t"}, {ch.slot_state, "slot_state_t"},
-      {ch.status, "process_status_t"}, {ch.run_event, "run_event_t"}};
+      {ch.status, "process_status_t"}, {ch.run_event, "run_event_t"}, {ch.map_state, "map_state_t"}};
   std::map<std::string, int> written;
   lcm::LogFile log((dir / "fuzz_file_run_log" / "run.lcmlog").string(), "w");
   int64_t n = 0;
@@ -69,6 +69,7 @@ int main(int argc, char** argv) {
                     : type == "associations_t"   ? accepted<associations_t>(*ev, &b)
                     : type == "slot_state_t"     ? accepted<slot_state_t>(*ev, &b)
                     : type == "run_event_t"      ? accepted<run_event_t>(*ev, &b)
+                    : type == "map_state_t"      ? accepted<map_state_t>(*ev, &b)
                                                  : accepted<process_status_t>(*ev, &b);
     if (!ok) continue;
     const fs::path out = dir / ("fuzz_msg_" + type) / ("sim-" + std::to_string(written[type]++));

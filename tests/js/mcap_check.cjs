@@ -42,7 +42,9 @@ function checkMessage(schemaName, msg, topic) {
     }
     case "foxglove.SceneUpdate":
       for (const e of msg.entities) {
-        if (e.cubes.length !== 1 || e.texts.length !== 1) errors.push(`${topic}: entity ${e.id} lacks its cube or text`);
+        // A box is one cube, a loop one line; each has one label.
+        if (e.cubes.length + e.lines.length === 0 || e.cubes.length > 1 || e.texts.length !== 1)
+          errors.push(`${topic}: entity ${e.id} lacks its cube (or line) or text`);
       }
       return { entities: msg.entities.length, lines: msg.entities.reduce((n, e) => n + e.lines.length, 0),
                texts: msg.entities.map((e) => e.texts[0]?.text) };

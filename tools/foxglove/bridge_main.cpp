@@ -100,6 +100,7 @@ int run(int argc, char** argv) {
   node.subscribe<odometry_t>(channels.odometry, [&](const odometry_t& m) { forward(m); });
   node.subscribe<associations_t>(channels.associations, [&](const associations_t& m) { forward(m); });
   node.subscribe<slot_state_t>(channels.slot_state, [&](const slot_state_t& m) { forward(m); });
+  node.subscribe<map_state_t>(channels.map_state, [&](const map_state_t& m) { forward(m); });
   node.subscribe<process_status_t>(channels.status, [&](const process_status_t& m) {
     if (m.name != "foxglove") forward(m);
   });

@@ -87,6 +87,9 @@ Converter::Converter(const Channels& channels, ConverterOptions options) : chann
       {"/tf", &frameTransformSchema(), channels_.slot_state},
       {"/slot/path", &posesInFrameSchema(), channels_.slot_state},
       {"/slot/tracks", &sceneUpdateSchema(), channels_.slot_state},
+      {"/map/tf", &frameTransformSchema(), channels_.map_state},
+      {"/map/path", &posesInFrameSchema(), channels_.map_state},
+      {"/map/loops", &sceneUpdateSchema(), channels_.map_state},
       {"/process_status", &processStatusSchema(), channels_.status},
   };
 }
@@ -103,6 +106,7 @@ Refusal Converter::convert(const std::string& channel, const void* data, size_t 
   if (channel == channels_.odometry) return as(odometry_t());
   if (channel == channels_.associations) return as(associations_t());
   if (channel == channels_.slot_state) return as(slot_state_t());
+  if (channel == channels_.map_state) return as(map_state_t());
   if (channel == channels_.status) return as(process_status_t());
   addRaw(channel, data, size, out);
   return {};
@@ -243,11 +247,11 @@ void Converter::add(const ground_truth_t& m, std::vector<Output>& out) {
   }
 }
 
-void Converter::posesInFrame(int64_t utime, const std::vector<pose_t>& poses) {
+void Converter::posesInFrame(int64_t utime, const std::vector<pose_t>& poses, const char* frame) {
   j_.clear();
   j_.beginObject().key("timestamp");
   time(j_, utime);
-  j_.field("frame_id", kWorldFrame).key("poses").beginArray();
+  j_.field("frame_id", frame).key("poses").beginArray();
   for (const auto& p : poses) pose(j_, p);
   j_.endArray().endObject();
 }
@@ -334,6 +338,65 @@ void Converter::add(const slot_state_t& m, std::vector<Output>& out) {
     endSceneUpdate();
     out.push_back({kTracks, std::move(j_.str()), m.utime});
   }
+}
+
+void Converter::add(const map_state_t& m, std::vector<Output>& out) {
+  map_path_.push_back(m.map_pose);
+  map_positions_[m.frame] = {m.map_pose.position[0], m.map_pose.position[1], m.map_pose.position[2]};
+  for (const loop_event_t& e : m.loops)
+    if (e.accepted) loops_.emplace_back(e.match_frame, e.query_frame);
+  if (wanted(kMapTf)) {
+    j_.clear();
+    j_.beginObject().key("timestamp");
+    time(j_, m.utime);
+    j_.field("parent_frame_id", kMapFrame).field("child_frame_id", kWorldFrame).key("translation");
+    vec3(j_, m.map_from_world.position[0], m.map_from_world.position[1], m.map_from_world.position[2]);
+    j_.key("rotation");
+    quat(j_, m.map_from_world.orientation);
+    j_.endObject();
+    out.push_back({kMapTf, std::move(j_.str()), m.utime});
+  }
+  if (wanted(kMapPath)) {
+    posesInFrame(m.utime, map_path_, kMapFrame);
+    out.push_back({kMapPath, std::move(j_.str()), m.utime});
+  }
+  if (!wanted(kMapLoops)) return;
+  // Every accepted loop so far, a red line from the place seen before to the scan that saw it again
+  // (each end where the mapper placed it when it came).
+  beginSceneUpdate(m.utime);
+  const float red[4] = {1.0f, 0.1f, 0.1f, 1.0f}, white[4] = {1, 1, 1, 1};
+  for (const auto& [match, query] : loops_) {
+    const auto a = map_positions_.find(match), b = map_positions_.find(query);
+    if (a == map_positions_.end() || b == map_positions_.end()) continue;
+    const auto& p = a->second;
+    const auto& q = b->second;
+    j_.beginObject().key("timestamp");
+    time(j_, m.utime);
+    j_.field("frame_id", kMapFrame).field("id", "loop/" + std::to_string(match) + "-" + std::to_string(query));
+    j_.key("lifetime");
+    time(j_, 0);
+    j_.field("frame_locked", false).key("metadata").beginArray();
+    j_.beginObject().field("key", "match_frame").field("value", std::to_string(match)).endObject();
+    j_.beginObject().field("key", "query_frame").field("value", std::to_string(query)).endObject();
+    j_.endArray().key("arrows").beginArray().endArray().key("cubes").beginArray().endArray();
+    j_.key("spheres").beginArray().endArray().key("cylinders").beginArray().endArray();
+    j_.key("lines").beginArray().beginObject().field("type", 0).key("pose");
+    poseYaw(j_, 0, 0, 0, 0);
+    j_.field("thickness", 0.4).field("scale_invariant", false).key("points").beginArray();
+    vec3(j_, p[0], p[1], p[2]);
+    vec3(j_, q[0], q[1], q[2]);
+    j_.endArray().key("color");
+    colour(j_, red);
+    j_.key("colors").beginArray().endArray().key("indices").beginArray().endArray().endObject().endArray();
+    j_.key("triangles").beginArray().endArray().key("texts").beginArray().beginObject().key("pose");
+    poseYaw(j_, q[0], q[1], q[2] + 2.0, 0);
+    j_.field("billboard", true).field("font_size", 14.0).field("scale_invariant", true).key("color");
+    colour(j_, white);
+    j_.field("text", "loop " + std::to_string(query) + " -> " + std::to_string(match)).endObject().endArray();
+    j_.key("models").beginArray().endArray().endObject();
+  }
+  endSceneUpdate();
+  out.push_back({kMapLoops, std::move(j_.str()), m.utime});
 }
 
 void Converter::add(const process_status_t& m, std::vector<Output>& out) {

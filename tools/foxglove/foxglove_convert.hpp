@@ -14,10 +14,14 @@
 //                     /slot/path             foxglove.PosesInFrame  (world)
 //                     /slot/tracks           foxglove.SceneUpdate   (world; cube, "id class speed" text,
 //                                                                    the track's recent path as a line)
+//   MAP_STATE      -> /map/tf                foxglove.FrameTransform map -> world (the loop closure's correction)
+//                     /map/path              foxglove.PosesInFrame  (map; the loop-closed pose of each scan as it came)
+//                     /map/loops             foxglove.SceneUpdate   (map; a line for every accepted loop so far)
 //   PROCESS_STATUS -> /process_status        dlslot.ProcessStatus
 //   any other      -> /lcm/CHANNEL           dlslot.LcmMessage (the raw bytes, base64)
 // Frames: "world" is the lidar frame of the first scan (design brief, section 3); "lidar" moves
-// with the vehicle, placed by /tf at each scan's timestamp.
+// with the vehicle, placed by /tf at each scan's timestamp; "map" is the mapper's loop-closed world
+// (identical to "world" until a loop closes).
 #pragma once
 
 #include <cstdint>
@@ -32,6 +36,7 @@
 #include "dlslot/config.hpp"
 #include "dlslot/detections_t.hpp"
 #include "dlslot/ground_truth_t.hpp"
+#include "dlslot/map_state_t.hpp"
 #include "dlslot/message_guard.hpp"
 #include "dlslot/odometry_t.hpp"
 #include "dlslot/point_cloud_t.hpp"
@@ -44,6 +49,8 @@ namespace dlslot::foxglove {
 
 inline constexpr const char* kWorldFrame = "world";
 inline constexpr const char* kLidarFrame = "lidar";
+// The mapper's loop-closed world; /map/tf places SLOT_STATE's world in it (T_map_world).
+inline constexpr const char* kMapFrame = "map";
 
 struct Topic {
   std::string name;          // e.g. "/lidar/points"
@@ -76,7 +83,8 @@ class Converter {
  public:
   // The fixed topics, in this order (indices into topics()).
   enum FixedTopic : size_t {
-    kScan, kDetections, kGtBoxes, kGtPath, kOdomPath, kAssociations, kTf, kSlotPath, kTracks, kStatus, kNumFixed
+    kScan, kDetections, kGtBoxes, kGtPath, kOdomPath, kAssociations, kTf, kSlotPath, kTracks,
+    kMapTf, kMapPath, kMapLoops, kStatus, kNumFixed
   };
 
   explicit Converter(const Channels& channels = Channels(), ConverterOptions options = {});
@@ -103,6 +111,7 @@ class Converter {
   void add(const odometry_t& m, std::vector<Output>& out);
   void add(const associations_t& m, std::vector<Output>& out);
   void add(const slot_state_t& m, std::vector<Output>& out);
+  void add(const map_state_t& m, std::vector<Output>& out);
   void add(const process_status_t& m, std::vector<Output>& out);
   void addRaw(const std::string& channel, const void* data, size_t size, std::vector<Output>& out);
 
@@ -110,7 +119,7 @@ class Converter {
 
  private:
   bool wanted(size_t topic) const { return !wanted_ || wanted_(topic); }
-  void posesInFrame(int64_t utime, const std::vector<pose_t>& poses);
+  void posesInFrame(int64_t utime, const std::vector<pose_t>& poses, const char* frame = kWorldFrame);
   void boxEntity(int64_t utime, const char* frame, const std::string& id, const box_t& b, const float rgba[4],
                  const std::string& label, const std::vector<std::pair<const char*, std::string>>& metadata,
                  const std::deque<std::array<double, 3>>* path = nullptr);
@@ -122,7 +131,9 @@ class Converter {
   std::vector<Topic> topics_;
   std::map<std::string, size_t> raw_topics_;  // channel -> topic index
   std::function<bool(size_t)> wanted_;
-  std::vector<pose_t> gt_path_, odom_path_, slot_path_;
+  std::vector<pose_t> gt_path_, odom_path_, slot_path_, map_path_;
+  std::map<int, std::array<double, 3>> map_positions_;  // frame -> its loop-closed position when it came
+  std::vector<std::pair<int, int>> loops_;             // accepted loops: (match frame, query frame)
   std::map<int, std::deque<std::array<double, 3>>> track_paths_;  // id -> recent world positions
   JsonText j_;
 };

@@ -75,6 +75,7 @@ struct Channels {
   std::string associations = "ASSOCIATIONS";
   std::string slot_state = "SLOT_STATE";
   std::string status = "PROCESS_STATUS";
+  std::string map_state = "MAP_STATE";  // optional key: the mapper's loop-closure correction and events
   std::string run_event = "RUN_EVENT";  // optional key (the player's start events)
   // Reads the section; every channel must have a name of its own: two roles on one channel (e.g.
   // odometry: SLOT_STATE) would feed one process's output to another as a different type.

@@ -23,6 +23,7 @@
 #include "dlslot/associations_t.hpp"
 #include "dlslot/detections_t.hpp"
 #include "dlslot/ground_truth_t.hpp"
+#include "dlslot/map_state_t.hpp"
 #include "dlslot/odometry_t.hpp"
 #include "dlslot/point_cloud_t.hpp"
 #include "dlslot/process_status_t.hpp"
@@ -52,6 +53,7 @@ Refusal checkLayout(const associations_t*, const void* data, size_t size);
 Refusal checkLayout(const slot_state_t*, const void* data, size_t size);
 Refusal checkLayout(const process_status_t*, const void* data, size_t size);
 Refusal checkLayout(const run_event_t*, const void* data, size_t size);
+Refusal checkLayout(const map_state_t*, const void* data, size_t size);
 
 // Step 3 for each type: the decoded values make sense.
 Refusal checkContent(const point_cloud_t& m);
@@ -62,6 +64,7 @@ Refusal checkContent(const associations_t& m);
 Refusal checkContent(const slot_state_t& m);
 Refusal checkContent(const process_status_t& m);
 Refusal checkContent(const run_event_t& m);
+Refusal checkContent(const map_state_t& m);
 
 // All three steps; `out` is only meaningful when the result is empty.
 template <class Msg>

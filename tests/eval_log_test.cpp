@@ -172,6 +172,13 @@ void writeRun(const std::string& path, bool with_truth = true) {
   status.name = "odometry";
   status.frames_handled = kFrames;
   write(log, "PROCESS_STATUS", status, 100000 * kFrames);
+  process_status_t backend{};
+  backend.name = "backend";
+  backend.frames_handled = kFrames;
+  backend.counter_names = {"registration_measured", "registration_too_few_points", "landmarks"};
+  backend.counter_values = {7, 3, 12};
+  backend.num_counters = 3;
+  write(log, "PROCESS_STATUS", backend, 100000 * kFrames + 1);
 }
 
 // A KITTI tracking layout with the same ground truth (poses in the lidar frame, labels in camera).
@@ -272,6 +279,11 @@ TEST_F(EvalLog, ARecordedRunGivesTheKnownMetrics) {
   EXPECT_EQ(*value(json, "tracking.fn"), 0);
   EXPECT_NEAR(*value(json, "tracking.hota"), 1.0, 1e-9);
   EXPECT_NEAR(*value(json, "tracking.velocity_rmse_mps"), 0.0, 1e-6);
+  EXPECT_NEAR(*value(json, "tracking.velocity_young_rmse_mps"), *value(json, "velocity.age.0-4.rmse_mps"), 1e-12);
+  // The backend's registrations by outcome, from its last status; its other counters are not these.
+  EXPECT_EQ(*value(json, "registration.measured"), 7);
+  EXPECT_EQ(*value(json, "registration.too_few_points"), 3);
+  EXPECT_EQ(json.find("registration.landmarks"), std::string::npos);
   EXPECT_DOUBLE_EQ(*value(json, "tracking_iou.mota"), 1.0);
   EXPECT_NEAR(*value(json, "tracking_iou.hota"), 1.0, 1e-9);
   // Timing: odometry totals 10, 11, 12, ... (mean 11, p95 12); stages get their own key.

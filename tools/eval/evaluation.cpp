@@ -89,6 +89,7 @@ Metrics evaluate(RunData run, const EvalOptions& options) {
   m.frame_counts = std::move(run.frame_counts);
   m.frames = std::move(run.frames);
   m.memory = std::move(run.memory);
+  m.registration = std::move(run.registration);
   m.odometry_checks = std::move(run.odometry_checks);
   m.map = std::move(run.map);
   m.notes.insert(m.notes.end(), run.notes.begin(), run.notes.end());

@@ -46,6 +46,7 @@ struct RunData {
   std::vector<std::string> notes;                // facts for the report (process health, warnings)
   std::optional<FrameAccounting> frames;         // where every played frame went (a recorded run)
   std::map<std::string, RssSummary> memory;      // process -> resident memory over the run
+  std::map<std::string, int64_t> registration;   // the backend's per-object registrations by outcome
   std::optional<MapMetrics> map;                 // --map
   std::optional<OdometryChecks> odometry_checks;  // a recorded run with SLOT_STATE
 };
@@ -80,6 +81,7 @@ struct Metrics {
   std::vector<std::string> notes;
   std::optional<FrameAccounting> frames;
   std::map<std::string, RssSummary> memory;
+  std::map<std::string, int64_t> registration;
   std::optional<MapMetrics> map;
   std::optional<OdometryChecks> odometry_checks;
 };

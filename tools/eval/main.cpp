@@ -415,6 +415,12 @@ int run(int argc, char** argv) {
     for (const std::string p : {"detector", "odometry", "tracker", "backend", "renderer", "mapper"})
       if (log->last_status.count(p)) pipeline.push_back(p);
     run.frames = accountFrames(log->last_status, log->frame_counts[channels.scan], pipeline);
+    // The backend counts its per-object registrations by outcome (registration_<outcome>).
+    if (const auto backend = log->last_status.find("backend"); backend != log->last_status.end())
+      for (int i = 0; i < backend->second.num_counters; ++i) {
+        const std::string& name = backend->second.counter_names[i];
+        if (name.rfind("registration_", 0) == 0) run.registration[name.substr(13)] = backend->second.counter_values[i];
+      }
     for (const auto& [process, samples] : log->rss_kb)
       if (const auto r = summarizeRss(samples)) run.memory[process] = *r;
     if (!log->refused.empty()) {

@@ -55,6 +55,11 @@ std::vector<std::pair<std::string, Opt>> trackingValues(const std::optional<Trac
   const auto count = [&](int ClearMot::*field) -> Opt {
     return t ? Opt(static_cast<double>(t->clear.*field)) : std::nullopt;
   };
+  // Tracks younger than 5 scans: the velocity breakdown's first age bin.
+  Opt young;
+  if (t)
+    for (const VelocityGroup& g : t->velocity_groups)
+      if (g.dimension == "age" && g.bin == "0-4") young = g.rmse_mps;
   return {{"mota", t ? t->clear.mota : std::nullopt},
           {"motp_m", t ? t->clear.motp_m : std::nullopt},
           {"idsw", count(&ClearMot::idsw)},
@@ -62,6 +67,7 @@ std::vector<std::pair<std::string, Opt>> trackingValues(const std::optional<Trac
           {"fn", count(&ClearMot::fn)},
           {"hota", t && t->hota ? Opt(t->hota->hota) : std::nullopt},
           {"velocity_rmse_mps", t ? t->clear.velocity_rmse_mps : std::nullopt},
+          {"velocity_young_rmse_mps", young},
           {"heading_rmse_deg", t ? t->clear.heading_rmse_deg : std::nullopt},
           {"heading_pairs", count(&ClearMot::heading_pairs)},
           {"heading_reversed", count(&ClearMot::heading_reversed)},
@@ -288,6 +294,7 @@ std::string metricsJson(const Metrics& m) {
     kv.emplace_back("memory.rss_mb." + process + ".three_quarters", num(r.three_quarters_mb));
     kv.emplace_back("memory.rss_mb." + process + ".end", num(r.end_mb));
   }
+  for (const auto& [outcome, n] : m.registration) kv.emplace_back("registration." + outcome, std::to_string(n));
   if (m.map) {
     const MapScore& s = m.map->score;
     kv.emplace_back("map.sa", num(s.sa));

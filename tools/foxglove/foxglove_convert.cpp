@@ -247,6 +247,17 @@ void Converter::add(const ground_truth_t& m, std::vector<Output>& out) {
   }
 }
 
+void Converter::frameTransform(int64_t utime, const char* parent, const char* child, const pose_t& child_in_parent) {
+  j_.clear();
+  j_.beginObject().key("timestamp");
+  time(j_, utime);
+  j_.field("parent_frame_id", parent).field("child_frame_id", child).key("translation");
+  vec3(j_, child_in_parent.position[0], child_in_parent.position[1], child_in_parent.position[2]);
+  j_.key("rotation");
+  quat(j_, child_in_parent.orientation);
+  j_.endObject();
+}
+
 void Converter::posesInFrame(int64_t utime, const std::vector<pose_t>& poses, const char* frame) {
   j_.clear();
   j_.beginObject().key("timestamp");
@@ -296,14 +307,7 @@ void Converter::add(const slot_state_t& m, std::vector<Output>& out) {
     it = present.count(it->first) ? std::next(it) : track_paths_.erase(it);
 
   if (wanted(kTf)) {
-    j_.clear();
-    j_.beginObject().key("timestamp");
-    time(j_, m.utime);
-    j_.field("parent_frame_id", kWorldFrame).field("child_frame_id", kLidarFrame).key("translation");
-    vec3(j_, m.ego_pose.position[0], m.ego_pose.position[1], m.ego_pose.position[2]);
-    j_.key("rotation");
-    quat(j_, m.ego_pose.orientation);
-    j_.endObject();
+    frameTransform(m.utime, kWorldFrame, kLidarFrame, m.ego_pose);
     out.push_back({kTf, std::move(j_.str()), m.utime});
   }
   if (wanted(kSlotPath)) {
@@ -346,14 +350,7 @@ void Converter::add(const map_state_t& m, std::vector<Output>& out) {
   for (const loop_event_t& e : m.loops)
     if (e.accepted) loops_.emplace_back(e.match_frame, e.query_frame);
   if (wanted(kMapTf)) {
-    j_.clear();
-    j_.beginObject().key("timestamp");
-    time(j_, m.utime);
-    j_.field("parent_frame_id", kMapFrame).field("child_frame_id", kWorldFrame).key("translation");
-    vec3(j_, m.map_from_world.position[0], m.map_from_world.position[1], m.map_from_world.position[2]);
-    j_.key("rotation");
-    quat(j_, m.map_from_world.orientation);
-    j_.endObject();
+    frameTransform(m.utime, kMapFrame, kWorldFrame, m.map_from_world);
     out.push_back({kMapTf, std::move(j_.str()), m.utime});
   }
   if (wanted(kMapPath)) {

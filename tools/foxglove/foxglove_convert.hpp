@@ -120,6 +120,8 @@ class Converter {
  private:
   bool wanted(size_t topic) const { return !wanted_ || wanted_(topic); }
   void posesInFrame(int64_t utime, const std::vector<pose_t>& poses, const char* frame = kWorldFrame);
+  // A foxglove.FrameTransform: the pose of `child` in `parent`.
+  void frameTransform(int64_t utime, const char* parent, const char* child, const pose_t& child_in_parent);
   void boxEntity(int64_t utime, const char* frame, const std::string& id, const box_t& b, const float rgba[4],
                  const std::string& label, const std::vector<std::pair<const char*, std::string>>& metadata,
                  const std::deque<std::array<double, 3>>* path = nullptr);

@@ -445,7 +445,8 @@ Refusal checkContent(const map_state_t& m) {
     const std::pair<double, const char*> scores[] = {
         {e.descriptor_distance, ".descriptor_distance"}, {e.inlier_ratio, ".inlier_ratio"}, {e.rmse_m, ".rmse_m"}};
     for (const auto& [value, field] : scores)
-      if (!std::isfinite(value) || value < 0) return {"bad_value", f + field + " = " + std::to_string(value) + ", expected finite >= 0"};
+      if (!std::isfinite(value) || value < 0)
+        return {"bad_value", f + field + " = " + std::to_string(value) + ", expected finite >= 0"};
   }
   return {};
 }

@@ -22,9 +22,11 @@
 #include "mapper/mapper.hpp"
 #include "mapper/pose_graph.hpp"
 #include "mapper/scan_context.hpp"
+#include "mapper/scan_opener.hpp"
 #include "mapper/track_boxes.hpp"
 #include "mapper/voxel_map.hpp"
 #include "dlslot/cpu_clock.hpp"
+#include "dlslot/message_auth.hpp"
 #include "dlslot/voxel_key.hpp"
 
 using namespace dlslot;
@@ -595,4 +597,59 @@ TEST(IdleWorker, InlineRunsEachJobInPost) {
   worker.post([&] { ++n; });
   EXPECT_EQ(n, 2);
   EXPECT_EQ(worker.backlog(), 0u);
+}
+
+// The opener must give the receiving thread exactly what opening on it gave: every scan, in the
+// order it arrived, with the same refusals (a forgery, a replay), whichever thread opened it.
+TEST(ScanOpener, OpensOffThreadInArrivalOrderWithTheSameRefusals) {
+  const RunKey key = makeRunKey();
+  MessageAuth tx(key);
+  std::vector<std::vector<uint8_t>> payloads, sent;
+  for (int i = 0; i < 40; ++i) {
+    payloads.emplace_back(70000 + 13 * i, static_cast<uint8_t>(i));  // larger than one LCM fragment
+    sent.push_back(tx.sealCopy("LIDAR_SCAN", payloads.back().data(), payloads.back().size()));
+  }
+  std::vector<uint8_t> forged = sent[3];
+  forged[kEnvelopeHeader + 10] ^= 1;
+  for (const bool threaded : {true, false}) {
+    SCOPED_TRACE(threaded ? "threaded" : "inline");
+    // Capacity 2: the receiving side outruns the opener, which then catches up at normal priority.
+    ScanOpener opener(key, "LIDAR_SCAN", threaded, 2);
+    std::vector<std::string> expected;  // "" = accepted
+    for (int i = 0; i < 40; ++i) {
+      opener.post(sent[i]);
+      expected.push_back("");
+      if (i == 3) {
+        opener.post(forged);
+        expected.push_back("bad_mac");
+      }
+      if (i == 7) {
+        opener.post(sent[5]);  // an old message sent again
+        expected.push_back("replayed");
+      }
+    }
+    opener.wait(/*lift=*/false);
+    std::vector<ScanOpener::Opened> out = opener.take();
+    ASSERT_EQ(out.size(), expected.size());
+    size_t next = 0;
+    for (size_t k = 0; k < out.size(); ++k) {
+      EXPECT_EQ(out[k].refusal.reason, expected[k]) << "message " << k;
+      if (!expected[k].empty()) continue;
+      const std::vector<uint8_t>& p = payloads[next++];
+      ASSERT_EQ(out[k].size, p.size()) << "message " << k;
+      EXPECT_TRUE(std::equal(p.begin(), p.end(), out[k].bytes.begin() + static_cast<long>(out[k].offset)));
+    }
+    EXPECT_EQ(next, payloads.size());
+    EXPECT_TRUE(opener.take().empty());  // taken once
+    EXPECT_TRUE(opener.priorityError().empty()) << opener.priorityError();
+  }
+  // Open mode (--insecure): plain messages pass as they are.
+  ScanOpener open_mode(std::nullopt, "LIDAR_SCAN", true, 4);
+  open_mode.post(payloads[0]);
+  open_mode.wait(/*lift=*/true);
+  const std::vector<ScanOpener::Opened> plain = open_mode.take();
+  ASSERT_EQ(plain.size(), 1u);
+  EXPECT_FALSE(plain[0].refusal);
+  EXPECT_EQ(plain[0].offset, 0u);
+  EXPECT_EQ(plain[0].size, payloads[0].size());
 }

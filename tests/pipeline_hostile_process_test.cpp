@@ -143,6 +143,7 @@ const std::map<std::string, std::vector<std::string>> kListens = {
     {"tracker", {"DETECTIONS", "ODOMETRY"}},
     {"backend", {"ODOMETRY", "ASSOCIATIONS"}},
     {"renderer", kFrameChannels},
+    {"mapper", {"LIDAR_SCAN", "SLOT_STATE"}},  // its scans are opened off LCM's thread: counted the same
     {"launcher", {"SLOT_STATE"}}};
 
 }  // namespace

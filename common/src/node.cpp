@@ -378,36 +378,41 @@ void Node::checkSize(const std::string& channel, int64_t bytes) {
                   std::to_string(kLargeMessageBytes) + " bytes or more (large_message_filter.hpp)");
 }
 
-void Node::subscribeRaw(const std::string& channel, RawHandler cb) {
+void Node::subscribeRaw(const std::string& channel, RawHandler cb) { addHandler(channel, std::move(cb), false); }
+
+void Node::subscribeSealed(const std::string& channel, RawHandler cb) { addHandler(channel, std::move(cb), true); }
+
+void Node::addHandler(const std::string& channel, RawHandler cb, bool sealed) {
   noteSubscription(channel);
   for (ChannelHandlers& h : handlers_)
     if (h.channel == channel) {
+      if (h.sealed != sealed)
+        throw std::logic_error(channel + ": a channel's handlers are either all sealed or all opened");
       h.handlers.push_back(std::move(cb));
       return;
     }
-  handlers_.push_back({this, channel, {std::move(cb)}});
+  handlers_.push_back({this, channel, {std::move(cb)}, sealed});
   lcm_.subscribeFunction<ChannelHandlers*>(
-      channel,
-      [](const lcm::ReceiveBuffer* rbuf, const std::string&, ChannelHandlers* h) { h->node->dispatch(h->channel, *rbuf); },
+      channel, [](const lcm::ReceiveBuffer* rbuf, const std::string&, ChannelHandlers* h) { h->node->dispatch(*h, *rbuf); },
       &handlers_.back());
 }
 
-void Node::dispatch(const std::string& channel, const lcm::ReceiveBuffer& rbuf) {
+void Node::dispatch(ChannelHandlers& h, const lcm::ReceiveBuffer& rbuf) {
+  if (h.sealed) {
+    for (size_t i = 0; i < h.handlers.size(); ++i) h.handlers[i](rbuf);
+    return;
+  }
   // The envelope first: nothing unauthenticated reaches a decoder or any state.
   const uint8_t* payload = nullptr;
   size_t size = 0;
-  if (const Refusal why = auth_.open(channel, rbuf.data, rbuf.data_size, &payload, &size)) {
-    status_.refused(channel, why);
+  if (const Refusal why = auth_.open(h.channel, rbuf.data, rbuf.data_size, &payload, &size)) {
+    status_.refused(h.channel, why);
     return;
   }
   lcm::ReceiveBuffer inner = rbuf;
   inner.data = const_cast<uint8_t*>(payload);
   inner.data_size = static_cast<uint32_t>(size);
-  for (ChannelHandlers& h : handlers_)
-    if (h.channel == channel) {
-      for (size_t i = 0; i < h.handlers.size(); ++i) h.handlers[i](inner);
-      return;
-    }
+  for (size_t i = 0; i < h.handlers.size(); ++i) h.handlers[i](inner);
 }
 
 void Node::publishSealed(const std::string& channel, size_t payload_size) {

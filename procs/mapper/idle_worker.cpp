@@ -69,8 +69,12 @@ void IdleWorker::liftLimits() {
 }
 
 void IdleWorker::drain() {
-  if (!threaded_) return;
   liftLimits();
+  wait();
+}
+
+void IdleWorker::wait() {
+  if (!threaded_) return;
   std::unique_lock<std::mutex> lock(mutex_);
   idle_.wait(lock, [this] { return queue_.empty() && !busy_; });
 }

@@ -39,6 +39,10 @@ class IdleWorker {
   void liftLimits();
   // liftLimits(), then waits until every job posted so far has run.
   void drain();
+  // Waits until every job posted so far has run, at the priority the thread has.
+  void wait();
+  // The thread's priority from now on: SCHED_IDLE (true) or normal (false); the share limit stays.
+  void setIdlePriority(bool idle) { if (threaded_) setPriority(idle); }
   // Jobs waiting (not counting the one running), and the most that ever waited.
   size_t backlog() const;
   size_t maxBacklog() const;

@@ -22,6 +22,7 @@
 #include "dlslot/timing_stats.hpp"
 #include "mapper/map_output.hpp"
 #include "mapper/mapper_messages.hpp"
+#include "mapper/scan_opener.hpp"
 
 using namespace dlslot;
 using namespace dlslot::mapper;
@@ -33,8 +34,13 @@ namespace {
 // metre or two, most scans are never decoded.
 struct RawScan {
   std::vector<uint8_t> bytes;
+  size_t offset = 0, size = 0;  // the LCM-encoded scan within `bytes`
 };
 using Joiner = FrameJoiner<RawScan, MapperInput>;
+
+// Scans that may wait for the opener before it catches up at normal priority: in lockstep one or
+// two are in flight; eight (~16 MB) absorb a few busy seconds at 10 frames/s.
+constexpr size_t kOpenerCapacity = 8;
 
 // The frame index of a LIDAR_SCAN whose layout checked: after the type hash and the utime (LCM is big-endian).
 int scanFrame(const uint8_t* data) {
@@ -60,10 +66,11 @@ int acceptScan(const uint8_t* data, size_t size, FrameOrder& order, ProcessStatu
 // only if the scan becomes a keyframe, and then on the mapper's keyframe thread. A keyframe whose
 // points do not decode is refused (Mapper::takeRefusedScans) and no keyframe is made of it.
 void feed(Mapper& mapper, Joiner::Joined& j) {
-  auto bytes = std::make_shared<std::vector<uint8_t>>(std::move(j.a->bytes));
-  j.b->load_scan = [bytes]() {
+  auto raw = std::make_shared<RawScan>(std::move(*j.a));
+  j.b->load_scan = [raw]() {
     point_cloud_t m;
-    if (const Refusal why = decodeChecked(bytes->data(), bytes->size(), &m)) throw ScanRefused(why.reason, why.detail);
+    if (const Refusal why = decodeChecked(raw->bytes.data() + raw->offset, raw->size, &m))
+      throw ScanRefused(why.reason, why.detail);
     return fromMsg(m);
   };
   mapper.add(std::move(*j.b));
@@ -137,7 +144,7 @@ int runOffline(const MapperConfig& config, const Channels& channels, const std::
     if (scan) {
       const uint8_t* data = static_cast<const uint8_t*>(ev->data);
       const int frame = acceptScan(data, size, order[ev->channel], guard, ev->channel, where);
-      if (frame >= 0) joiner.addA(frame, RawScan{std::vector<uint8_t>(data, data + size)}, 0.0);
+      if (frame >= 0) joiner.addA(frame, RawScan{std::vector<uint8_t>(data, data + size), 0, size}, 0.0);
     } else {
       slot_state_t m;
       Refusal why = decodeChecked(ev->data, size, &m);
@@ -166,7 +173,25 @@ int runLive(const MapperConfig& config, const Channels& channels, const NodeOpti
   Mapper mapper(config, /*threaded=*/true);
   for (const std::string& e : mapper.priorityErrors()) node.status().warn(e + " (it runs at normal priority)");
   Joiner joiner(config.join_timeout_s);
+  // Scans are opened (their MAC checked) off this thread; their layout and frame order are checked
+  // here, in the order they arrived, as they come out of the opener.
+  ScanOpener opener(node.auth().key(), channels.scan, /*threaded=*/true, kOpenerCapacity);
+  if (const std::string e = opener.priorityError(); !e.empty()) node.status().warn(e + " (it runs at normal priority)");
+  FrameOrder scan_order;
+  auto takeOpened = [&] {
+    for (ScanOpener::Opened& o : opener.take()) {
+      if (o.refusal) {
+        node.status().refused(channels.scan, o.refusal);
+        continue;
+      }
+      const int frame = acceptScan(o.bytes.data() + o.offset, o.size, scan_order, node.status(), channels.scan, "");
+      if (frame < 0) continue;
+      if (!joiner.addA(frame, RawScan{std::move(o.bytes), o.offset, o.size}, nowSeconds()))
+        node.status().warn("LIDAR_SCAN of frame " + std::to_string(frame) + " arrived after the frame was released");
+    }
+  };
   auto handleReady = [&] {
+    takeOpened();
     for (Joiner::Joined& j : joiner.release(nowSeconds())) {
       if (!j.a) node.status().timeout("LIDAR_SCAN of frame " + std::to_string(j.frame));
       if (!j.b) node.status().timeout("SLOT_STATE of frame " + std::to_string(j.frame));
@@ -191,17 +216,16 @@ int runLive(const MapperConfig& config, const Channels& channels, const NodeOpti
       }
     }
   };
-  // The scans raw (their points decoded for keyframes only); SLOT_STATE's subscription counts the
-  // frames received.
-  FrameOrder scan_order;
-  node.onRestart([&](const run_event_t&) { scan_order.reset(); });
-  node.subscribeRaw(channels.scan, [&](const lcm::ReceiveBuffer& rbuf) {
+  // The scans sealed, to the opener (their points are decoded for keyframes only). A restart
+  // forgets the frame order only after the scans that came before it are through.
+  node.onRestart([&](const run_event_t&) {
+    opener.wait(/*lift=*/false);
+    takeOpened();
+    scan_order.reset();
+  });
+  node.subscribeSealed(channels.scan, [&](const lcm::ReceiveBuffer& rbuf) {
     const uint8_t* data = static_cast<const uint8_t*>(rbuf.data);
-    const int frame = acceptScan(data, rbuf.data_size, scan_order, node.status(), channels.scan, "");
-    if (frame < 0) return;
-    if (!joiner.addA(frame, RawScan{std::vector<uint8_t>(data, data + rbuf.data_size)}, nowSeconds()))
-      node.status().warn("LIDAR_SCAN of frame " + std::to_string(frame) + " arrived after the frame was released");
-    handleReady();
+    opener.post(std::vector<uint8_t>(data, data + rbuf.data_size));
   });
   node.subscribeFrames<slot_state_t>(channels.slot_state, [&](const slot_state_t& m) {
     if (!joiner.addB(m.frame, inputFromMsg(m), nowSeconds()))
@@ -217,14 +241,18 @@ int runLive(const MapperConfig& config, const Channels& channels, const NodeOpti
     getrusage(RUSAGE_SELF, &usage);
     const double total_ms = 1e3 * (usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
                             1e-3 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-    const double idle_ms = mapper.workerCpuMs();
+    const double idle_ms = mapper.workerCpuMs() + opener.cpuMs();
     const double frames = std::max<double>(1, static_cast<double>(node.status().framesHandled()));
     std::printf("mapper: CPU while the pipeline ran: %.2f ms a frame at normal priority (receiving, joining, MAP_STATE; "
-                "start-up included), %.2f ms a frame at idle priority (keyframes, loop closure), %zu keyframes waiting "
-                "at the end\n",
-                (total_ms - idle_ms) / frames, idle_ms / frames, mapper.snapshot().backlog);
+                "start-up included), %.2f ms a frame at idle priority (opening scans, keyframes, loop closure), %zu "
+                "keyframes waiting at the end; the scan opener was %zu scans behind at most and caught up at normal "
+                "priority %d times\n",
+                (total_ms - idle_ms) / frames, idle_ms / frames, mapper.snapshot().backlog, opener.maxBacklog(),
+                opener.catchUps());
   }
   // Stopped (SIGINT/SIGTERM): what is still waiting goes in, then the files.
+  opener.wait(/*lift=*/true);
+  takeOpened();
   for (Joiner::Joined& j : joiner.flush())
     if (j.a && j.b) feed(mapper, j);
   mapper.finish();

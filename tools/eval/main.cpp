@@ -17,9 +17,11 @@
 #include "dlslot/input_error.hpp"
 #include "dlslot/kitti.hpp"
 #include "dlslot/node.hpp"
+#include "dlslot/progress.hpp"
 #include "evaluation.hpp"
 #include "export.hpp"
 #include "metrics_report.hpp"
+#include "object_points.hpp"
 #include "plots.hpp"
 #include "run_log.hpp"
 
@@ -350,6 +352,31 @@ void addMap(const Options& o, const DataSet& data, RunData& run) {
   run.map = mm;
 }
 
+// --object-points: the labelled objects' point counts of one sequence, by class and range.
+int reportObjectPoints(const Options& o) {
+  if (o.kitti_root.empty() || o.sequence.empty()) throw std::invalid_argument("--object-points needs --kitti ROOT --sequence S");
+  const kitti::SequenceReader reader(o.kitti_root, o.sequence);
+  if (!reader.hasScans() || !reader.hasLabels())
+    throw std::invalid_argument(o.kitti_root + " sequence " + o.sequence + ": --object-points needs scans and labels");
+  const ObjectPointOptions options;
+  std::vector<ObjectPoints> samples;
+  ProgressLine progress("object points, " + o.sequence, reader.size());
+  for (int i = 0; i < reader.size(); ++i) {
+    const Frame f = reader.read(i);
+    const std::vector<ObjectPoints> counted = countObjectPoints(f.index, f.scan, f.labels, options);
+    samples.insert(samples.end(), counted.begin(), counted.end());
+    progress.update(i + 1);
+  }
+  progress.finish(std::to_string(samples.size()) + " labelled objects");
+  std::cout << objectPointTable(summariseObjectPoints(samples, options));
+  if (!o.out.empty()) {
+    std::filesystem::create_directories(o.out);
+    writeObjectPointsCsv(o.out + "/object_points.csv", samples);
+    std::cout << "wrote " << o.out << "/object_points.csv\n";
+  }
+  return 0;
+}
+
 int run(int argc, char** argv) {
   Options o;
   CommandLine cl("dlslot-eval",
@@ -382,7 +409,12 @@ int run(int argc, char** argv) {
   cl.option("--frame-period", &o.frame_period, "seconds per scan for files without timestamps (default 0.1)");
   cl.flag("--allow-missing-truth", &o.allow_missing_truth, "report timing alone when there is no ground truth");
   cl.flag("--quiet", &o.quiet, "no summary on stdout");
+  bool object_points = false;
+  cl.flag("--object-points", &object_points,
+          "only the points inside each labelled box, by class and range (needs --kitti ROOT --sequence S; "
+          "--out DIR adds object_points.csv): how densely the lidar samples the objects, to compare data sets");
   if (!cl.parse(argc, argv)) return 0;
+  if (object_points) return reportObjectPoints(o);
   if (o.log.empty() && o.traj.empty() && o.tracks.empty())
     throw std::invalid_argument("nothing to evaluate: give --log RUN.lcmlog, --traj FILE or --tracks FILE\n" + cl.usage());
   if (!o.tracks.empty() && o.kitti_root.empty())

@@ -421,6 +421,28 @@ TEST(BackendSlidingWindow, CoastingTrackKeepsItsVelocityWhileItsChainLeavesTheWi
   EXPECT_GE(coasting, 8);
 }
 
+TEST(BackendSlidingWindow, ACarSeenTurnedRoundIsPublishedHeadingWhereItGoes) {
+  // Every box of this car points backwards (a detector's heading turned by pi) while it drives
+  // along +x at 12 m/s: the published heading is its direction of travel once it is moving.
+  SimScene scene;
+  scene.ego = constantTwist(Pose::Identity(), 8.0, 0.0);
+  SimObject car;
+  car.id = 1;
+  car.pose = constantTwist(planarPose(10, -3.5, M_PI), -12.0, 0.0);  // facing -x, moving +x
+  scene.objects = {car};
+  scene.box_noise = Eigen::Vector3d(0.1, 0.1, 0.05);
+  SlidingWindow window(streetConfig());
+  int checked = 0;
+  for (const BackendOutput& out : run(window, scene.generate(30)))
+    for (const TrackEstimate& e : out.tracks) {
+      if (!e.dynamic || e.velocity.head<2>().norm() < 6.0) continue;
+      EXPECT_GT(e.velocity.x(), 6.0) << "frame " << out.frame;
+      EXPECT_NEAR(std::abs(wrapAngle(yawOf(e.pose.linear()))), 0.0, 0.1) << "frame " << out.frame;
+      ++checked;
+    }
+  EXPECT_GE(checked, 15);
+}
+
 TEST(BackendSlidingWindow, ParkedCarPullsOutTurnsDynamic) {
   SimScene scene;
   scene.ego = constantTwist(Pose::Identity(), 5.0, 0.0);

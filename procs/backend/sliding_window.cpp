@@ -480,6 +480,12 @@ void SlidingWindow::solve(BackendOutput& out) {
   out.stats.covariance_ms = msSince(t1);
 }
 
+namespace {
+// Faster than a vehicle reverses in traffic (walking pace, < 2 m/s), with a margin for the
+// velocity error of a young track (~1 m/s).
+constexpr double kSurelyForwardMps = 3.0;
+}  // namespace
+
 void SlidingWindow::fillTracks(BackendOutput& out) {
   const int t = frames_.back().frame;
   auto covariance = [&](const double* block) -> Matrix6 {
@@ -550,6 +556,14 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
       }
       if (track.velocity) e.velocity = *track.velocity;
       e.angular_velocity = track.angular_velocity;
+      // alignedBox keeps a track's heading consistent with itself, so a track born from a box
+      // turned round heads backwards for good. Vehicles in traffic reverse at walking pace at
+      // most: one moving faster than kSurelyForwardMps heads where it goes, and a track found
+      // heading the other way is published turned by pi (the same box; velocity and covariance
+      // are world-frame and unchanged). Decided anew whenever the speed says so, kept in between.
+      if (isVehicle(track.type) && track.velocity && track.velocity->head<2>().norm() > kSurelyForwardMps)
+        track.reversed = track.velocity->head<2>().dot(e.pose.linear().col(0).head<2>()) < 0;
+      if (track.reversed) e.pose.linear() = e.pose.linear() * Eigen::Vector3d(-1, -1, 1).asDiagonal();
     }
     if (block) e.covariance = covariance(block);
     out.tracks.push_back(std::move(e));

@@ -74,6 +74,7 @@ class SlidingWindow {
     // chain to estimate it again (coasting, or about to leave).
     std::optional<Eigen::Vector3d> velocity;
     bool velocity_from_chain = false;
+    bool reversed = false;  // its boxes' heading points backwards: published turned by pi (fillTracks)
     // Per-object registration: the object's points of its latest scan (world frame, prepared:
     // the next frame's previous points), and the motions measured between consecutive scans
     // (frame t -> M of t-1 -> t, world frame).

@@ -66,6 +66,7 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   c.constant_velocity_sigma = readSigmas(s, "constant_velocity_sigma");
   c.first_pose_sigma = readSigmas(s, "first_pose_sigma");
   c.constant_acceleration_sigma = readSigmas<3>(s, "constant_acceleration_sigma", "x m, y m, z m");
+  s.get("marginalize_acceleration", c.marginalize_acceleration);
   s.get("observation_sigma_growth_per_m", c.observation_sigma_growth_per_m);
   c.vehicle_motion_sigma = readSigmas<4>(s, "vehicle_motion_sigma", "lateral m, vertical m, roll rad, pitch rad");
   s.get("vehicle_types", c.vehicle_types);

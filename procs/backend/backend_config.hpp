@@ -35,6 +35,9 @@ struct BackendConfig {
   // Second difference of a dynamic object's per-frame translation (constant_acceleration_factor.hpp),
   // x y z in m; eq. 11's constant_velocity_sigma then bounds the acceleration itself.
   Eigen::Vector3d constant_acceleration_sigma = Eigen::Vector3d(0.005, 0.005, 0.005);
+  // Marginalize the constant-acceleration factors of a leaving pose change into the prior (the
+  // acceleration survives the window's slide) instead of dropping them.
+  bool marginalize_acceleration = true;
   Vector6 first_pose_sigma = (Vector6() << 1e-3, 1e-3, 1e-3, 1e-4, 1e-4, 1e-4).finished();
   // The vehicle motion prior on every pose change of a vehicle (vehicle_motion_factor.hpp):
   // sigmas of its lateral and vertical translation (m) and roll and pitch (rad) per frame, and

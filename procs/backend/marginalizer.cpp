@@ -1,5 +1,6 @@
 #include "backend/marginalizer.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -86,6 +87,26 @@ bool factorize(const Eigen::MatrixXd& H, const Eigen::VectorXd& g, dense::RowMat
     r = g;
     dense::solveLower(L, r);
     return true;
+  }
+  // Directions no factor informs at all (exactly zero rows and columns: the rotation of a pose
+  // change that only a constant-acceleration factor, which measures translations, ties to the
+  // leaving blocks) carry no information: the rest is factorized without them, and J has zero
+  // columns there. Only a rest that is still singular needs the eigen-decomposition.
+  std::vector<Eigen::Index> informed;
+  for (Eigen::Index i = 0; i < H.rows(); ++i)
+    if (H.row(i).cwiseAbs().maxCoeff() > 0.0) informed.push_back(i);
+  if (!informed.empty() && static_cast<Eigen::Index>(informed.size()) < H.rows()) {
+    const Eigen::Index m = static_cast<Eigen::Index>(informed.size());
+    Eigen::MatrixXd Lr = H(informed, informed);
+    if (dense::cholesky(Lr)) {
+      Lr.triangularView<Eigen::StrictlyUpper>().setZero();
+      Eigen::VectorXd gr = g(informed);
+      dense::solveLower(Lr, gr);
+      J = dense::RowMatrix::Zero(m, H.cols());
+      for (Eigen::Index k = 0; k < m; ++k) J.col(informed[k]) = Lr.row(k).transpose();  // J = L^T
+      r = gr;
+      return true;
+    }
   }
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(H);
   const double eps = 1e-10 * std::max(1.0, es.eigenvalues().cwiseAbs().maxCoeff());

@@ -13,6 +13,7 @@
 #include "backend/observation_factor.hpp"
 #include "backend/odometry_factor.hpp"
 #include "backend/pose_change_factor.hpp"
+#include "backend/registered_velocity.hpp"
 #include "backend/registration_factor.hpp"
 #include "backend/vehicle_motion_factor.hpp"
 
@@ -284,10 +285,14 @@ std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track) const {
   return fitSpeedAmongOutliers(positions, sigma, 5.0);
 }
 
-std::optional<Eigen::Vector3d> SlidingWindow::boxLineVelocity(const Track& track) const {
+std::optional<SlidingWindow::LineVelocity> SlidingWindow::boxLineVelocity(const Track& track) const {
   const std::optional<SpeedFit> fit = windowMotion(track);
   if (!fit) return std::nullopt;
-  if (!isVehicle(track.type)) return fit->velocity;
+  LineVelocity line;
+  line.velocity = fit->velocity;
+  const double var_fit = std::max(fit->sigma * fit->sigma, 1e-6);
+  line.covariance = var_fit * Eigen::Matrix2d::Identity();
+  if (!isVehicle(track.type)) return line;
   // The mean heading of its boxes in the window (each box's own yaw noise is observation_sigma's rz).
   Eigen::Vector2d heading = Eigen::Vector2d::Zero();
   int n = 0;
@@ -297,8 +302,35 @@ std::optional<Eigen::Vector3d> SlidingWindow::boxLineVelocity(const Track& track
       heading += Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
       ++n;
     }
-  if (n == 0 || heading.norm() < 1e-9) return fit->velocity;
-  return velocityAlongHeading(*fit, heading.normalized(), config_.observation_sigma[5] / std::sqrt(double(n)));
+  if (n == 0 || heading.norm() < 1e-9) return line;
+  heading.normalize();
+  const double heading_sigma = config_.observation_sigma[5] / std::sqrt(double(n));
+  line.velocity = velocityAlongHeading(*fit, heading, heading_sigma);
+  // Across the heading the fused variance of the two (velocityAlongHeading's weights).
+  const double var_heading = std::pow(fit->velocity.head<2>().norm() * heading_sigma, 2);
+  const Eigen::Vector2d across(-heading.y(), heading.x());
+  const double var_across = std::max(var_fit * var_heading / (var_fit + var_heading), 1e-6);
+  line.covariance = var_fit * heading * heading.transpose() + var_across * across * across.transpose();
+  return line;
+}
+
+Eigen::Vector3d SlidingWindow::youngVehicleVelocity(const Track& track, const LineVelocity& line) const {
+  std::vector<VelocityEvidence> registered;
+  for (const auto& [f, motion] : track.motions) {
+    const auto prev = track.observations.find(f - 1);
+    const EgoFrame *a = findFrame(f - 1), *b = findFrame(f);
+    if (prev == track.observations.end() || !a || !b) continue;
+    const double dt = 1e-6 * static_cast<double>(b->utime - a->utime);
+    const Eigen::Vector3d p_prev = fromBlock(a->pose->data()) * prev->second.b.translation();
+    // The ego's per-frame translation error: the odometry factor's sigma (eq. 8).
+    const double ego_sigma = 0.5 * (config_.odometry_sigma[0] + config_.odometry_sigma[1]);
+    if (const auto v = registeredVelocity(motion.M, motion.information, p_prev, dt, ego_sigma)) registered.push_back(*v);
+  }
+  if (registered.empty()) return line.velocity;
+  Eigen::Vector3d out = line.velocity;
+  const auto fused = fuseVelocities(line.velocity.head<2>(), line.covariance, registered);
+  out.head<2>() = fused.first;
+  return out;
 }
 
 void SlidingWindow::startTrack(Track& track, int frame) {
@@ -498,7 +530,7 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
         // turn (intersection seeds 3 and 10: 6 and 18 errors > 3 m/s; none with the line), and the
         // line is better on the tuning seeds 1-5 (pedestrian velocity RMSE 0.308 / 0.442 / 0.657 /
         // 0.489 / 0.474 -> 0.296 / 0.422 / 0.413 / 0.415 / 0.422 m/s).
-        if (const auto v = boxLineVelocity(track)) track.velocity = v;
+        if (const auto line = boxLineVelocity(track)) track.velocity = line->velocity;
       } else if (static_cast<int>(track.changes.size()) >= config_.window_size - 1) {
         // The linear velocity from the chain (eq. 10-11 and the constant-acceleration factor smooth
         // it) once the chain spans the window: from then on the marginalization prior carries its
@@ -518,8 +550,9 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
       } else if (!track.velocity_from_chain) {
         // Young: the line through its boxes in the window (evidence before initialization
         // included), turned toward their heading for a vehicle. A track whose chain the window
-        // has cut short (coasting, or leaving) keeps the velocity its chain last gave.
-        if (const auto v = boxLineVelocity(track)) track.velocity = v;
+        // has cut short (coasting, or leaving) keeps the velocity its chain last gave. Its points'
+        // registrations, when it has any, measure the same motion far better than 2-9 boxes.
+        if (const auto line = boxLineVelocity(track)) track.velocity = youngVehicleVelocity(track, *line);
       }
       if (track.velocity) e.velocity = *track.velocity;
       e.angular_velocity = track.angular_velocity;
@@ -559,15 +592,19 @@ SmoothedPose SlidingWindow::slide() {
     for (const auto& [f, block] : track.changes)
       if (f <= s || !seen_later) leaving.insert(block->data());
   }
-  // Constant-acceleration factors on a leaving pose change are dropped, not marginalized: with
-  // them the prior would hold two pose changes of every moving object instead of one (20 cars in
-  // backend_bench: 366 dimensions instead of 246, 49 ms a frame instead of 8). The window's own
-  // factors still carry the acceleration of its last frames, eq. 11 the velocity. Measured cost:
-  // velocity RMSE on highway / highway-jam / intersection seed 1 0.442 / 0.492 / 0.383 m/s,
-  // against 0.418 / 0.450 / 0.358 when marginalized (holding the leaving change at its estimate
-  // instead pinned the objects' velocities and let them push a stopped ego 6 m: a unit test).
+  // Constant-acceleration factors on a leaving pose change: marginalized with it when
+  // marginalize_acceleration is set, else dropped. Dropped, the prior holds one pose change of
+  // every moving object and eq. 11 alone carries its motion across the slide: a random-walk
+  // velocity model, whose newest velocity trails a braking or accelerating object by a steady
+  // lag (an alpha-beta filter's (alpha - beta/2)/beta frames; measured 0.2-0.4 s on the
+  // simulated traffic, docs/object-motion.md). Marginalized, the prior holds two pose changes
+  // per object, i.e. the acceleration, and a constant acceleration is followed without lag.
+  // (It used to cost 6x the marginalization: the kept second pose change has no rotation
+  // information, the CA factor measures translations, and the singular prior went to an
+  // eigen-decomposition; the Marginalizer now factorizes without such directions.)
   factors_.erase(std::remove_if(factors_.begin(), factors_.end(),
                                 [&](const Factor& f) {
+                                  if (config_.marginalize_acceleration) return false;
                                   if (!dynamic_cast<const ConstantAccelerationFactor*>(f.cost.get())) return false;
                                   for (double* b : f.blocks)
                                     if (leaving.count(b)) return true;

@@ -100,7 +100,14 @@ class SlidingWindow {
   // The velocity of the line through the track's boxes in the window (windowMotion), for a
   // vehicle turned toward the mean heading of its boxes (velocityAlongHeading): a young
   // vehicle's, and a pedestrian's at every age.
-  std::optional<Eigen::Vector3d> boxLineVelocity(const Track& track) const;
+  struct LineVelocity {
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+    Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity();  // bird's-eye
+  };
+  std::optional<LineVelocity> boxLineVelocity(const Track& track) const;
+  // A young vehicle's line velocity fused with the velocities its registrations in the window
+  // measured (registered_velocity.hpp); the line as it is without registrations.
+  Eigen::Vector3d youngVehicleVelocity(const Track& track, const LineVelocity& line) const;
   // The least-squares motion of the track's observed positions in the window (world frame).
   std::optional<SpeedFit> windowMotion(const Track& track) const;
   void addTrackObservation(Track& track, int frame);

@@ -1,0 +1,39 @@
+// A young vehicle's velocity over ground from its own points. Until its chain spans the window
+// a vehicle's velocity is the line through its few boxes (motion_evidence.hpp), each box good to
+// 0.1-0.3 m: over 2-4 frames that line is worth 0.5-2 m/s. One registration of its points
+// between consecutive scans (object_registration.hpp) measures the same motion to a few
+// centimetres in the directions it constrains; in the world frame it carries the ego's
+// per-frame error too. Both are fused by information, bird's-eye.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+#include "backend/se3.hpp"
+
+namespace dlslot::backend {
+
+// A velocity estimate (m/s, world x-y) with its information (rank-deficient where unmeasured).
+struct VelocityEvidence {
+  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d information = Eigen::Matrix2d::Zero();
+};
+
+// The velocity a registration implies: M (world, o_t = M o_{t-1}) moves the object's centre
+// p_prev (world, at t-1) by M p_prev - p_prev in dt seconds. Its information: the registration's
+// (`information`, world tangent of M: translation then rotation) carried to the centre's
+// displacement with the rotation marginalized, then the ego's per-frame translation error
+// (ego_sigma_m per axis, it moves both scans' points against each other) added to each measured
+// direction. Nothing when dt <= 0 or no horizontal direction was measured.
+std::optional<VelocityEvidence> registeredVelocity(const Pose& M, const Matrix6& information,
+                                                   const Eigen::Vector3d& p_prev, double dt, double ego_sigma_m);
+
+// The information-weighted mean of a line's velocity (covariance line_covariance, full rank) and
+// registered velocities. A registration whose velocity disagrees with the line beyond the
+// chi-square gate (99 % for its measured directions) is another object's or a failed one and
+// is left out. Returns the fused velocity and how many registrations it used.
+std::pair<Eigen::Vector2d, int> fuseVelocities(const Eigen::Vector2d& line_velocity, const Eigen::Matrix2d& line_covariance,
+                                               const std::vector<VelocityEvidence>& registered);
+
+}  // namespace dlslot::backend

@@ -110,7 +110,11 @@ void LoopCloser::process(KeyframeInput in) {
     if (!(best >= 0 && best_match.distance <= config_.max_descriptor_distance)) best = -1;
     // A nearest-keyframe candidate is verified every other keyframe (the query moves on by
     // metres between them; verification is the costly part).
-    const int candidate = best >= 0 ? best : (nearest >= 0 && id % 2 == 0 ? nearest : -1);
+    // Right after an accepted loop the next keyframe is verified too: it sees the same place, and
+    // each query's own registration is another loop edge (their errors partly average, and the
+    // keyframes at the end of a drive get a constraint of their own); so is the run's last one.
+    const bool follows_loop = last_accepted_ == id - 1 || in.last;
+    const int candidate = best >= 0 ? best : (nearest >= 0 && (id % 2 == 0 || follows_loop) ? nearest : -1);
     if (candidate >= 0) {
       const Keyframe& c = keyframes_[candidate];
       const Pose T_c = graph_.pose(candidate);
@@ -156,8 +160,10 @@ void LoopCloser::process(KeyframeInput in) {
             config_.loop_sigma_r, config_.loop_sigma_r;
         graph_.addLoopEdge(candidate, id, e.verdict.registration.T_match_query, sigma);
         graph_.optimize();
-        // The next loop is looked for a few keyframes on: neighbours of an accepted loop repeat it.
-        quiet_until_ = id + 10;
+        // quiet_keyframes > 0: the next loop is looked for that many keyframes on (neighbours of an
+        // accepted loop repeat it); 0: every following keyframe may add its own edge.
+        quiet_until_ = id + config_.quiet_keyframes;
+        last_accepted_ = id;
       }
       event = e;
     }

@@ -25,6 +25,7 @@ struct KeyframeInput {
   Pose odometry = Pose::Identity();  // T_world_lidar from SLOT_STATE
   PointCloud points;                 // static points, lidar frame
   bool keep_cloud = true;            // false: used as a query now, not kept as a candidate (a place already held)
+  bool last = false;                 // the run's last keyframe: its nearest candidate is always verified
 };
 
 struct LoopEvent {
@@ -79,6 +80,7 @@ class LoopCloser {
   std::vector<Keyframe> keyframes_;
   PoseGraph graph_;
   int quiet_until_ = -1;  // no search before this keyframe (just after an accepted loop)
+  int last_accepted_ = -2;  // the query keyframe of the last accepted loop
 
   mutable std::mutex mutex_;
   std::optional<std::vector<Pose>> optimized_;

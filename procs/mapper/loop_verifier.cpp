@@ -109,7 +109,36 @@ LoopVerdict verifyLoop(const PointCloud& query, const PointCloud& match, const P
   const Cloud::Ptr q = toPcl(query), m = toPcl(match);
   pcl::KdTreeFLANN<pcl::PointXYZ> tree;
   tree.setInputCloud(m);
-  const Registration best = align(q, m, query, tree, prior, c);
+  const double max_t = 1.0 + c.max_drift_fraction * path_m, max_r = 2.0 + path_m / 100.0;
+  auto withinDrift = [&](const Pose& T) {
+    const Pose change = prior.inverse() * T;
+    return change.translation().norm() <= max_t && angleDeg(change.rotation()) <= max_r;
+  };
+  // Several starts: GICP from the odometry's estimate can slide along a street into a wrong
+  // minimum when the drift is metres. The query may lie anywhere within the drift bound (test 2),
+  // so starts shifted start_step_m, 2 x start_step_m, ... along the query's x and y (the street's
+  // directions; the coarse stage's reach covers the space between them), those within the bound
+  // only, are registered too; the result the overlap measure (test 1) scores best is kept. The
+  // direct start's result stays unless another lands elsewhere (> 0.5 m away) with a higher score,
+  // so where it was right nothing changes; a wrong pose that wins is still refused by tests 1-3.
+  auto valid = [&](const Registration& r) { return r.converged && withinDrift(r.T_match_query); };
+  Registration best = align(q, m, query, tree, prior, c);
+  v.starts.push_back({Eigen::Vector3d::Zero(), best});
+  for (int k = 1; k <= c.start_steps; ++k) {
+    const double s = k * c.start_step_m;
+    if (s > max_t) break;
+    for (const Eigen::Vector3d& shift : {Eigen::Vector3d(s, 0, 0), Eigen::Vector3d(-s, 0, 0), Eigen::Vector3d(0, s, 0),
+                                        Eigen::Vector3d(0, -s, 0)}) {
+      const Registration alt = align(q, m, query, tree, prior * Eigen::Translation3d(shift), c);
+      v.starts.push_back({shift, alt});
+      if (!valid(alt)) continue;
+      const double apart = (alt.T_match_query.translation() - best.T_match_query.translation()).norm();
+      if (!valid(best) || (apart > 0.5 && alt.inlier_ratio > best.inlier_ratio)) {
+        best = alt;
+        v.start_shift = shift;
+      }
+    }
+  }
   v.registration = best;
   std::ostringstream why;
   if (!best.converged) {
@@ -124,7 +153,6 @@ LoopVerdict verifyLoop(const PointCloud& query, const PointCloud& match, const P
     return v;
   }
   const Pose change = prior.inverse() * best.T_match_query;
-  const double max_t = 1.0 + c.max_drift_fraction * path_m, max_r = 2.0 + path_m / 100.0;
   if (change.translation().norm() > max_t || angleDeg(change.rotation()) > max_r) {
     why.precision(3);
     why << "drift bound: the registration moves the query " << change.translation().norm() << " m / "

@@ -9,6 +9,9 @@
 //   2. drift bound: the registration moves the query at most 1 m + max_drift_fraction x the path
 //      driven since the match (and 2 deg + 1 deg per 100 m) away from where the odometry puts it:
 //      anything farther is not drift but a wrong place;
+//   The registration runs from several starts (the prior and starts shifted along the query's x and
+//   y within the drift bound) and keeps the result the overlap measure scores best: from the
+//   odometry's estimate alone GICP can slide along a street into a wrong minimum.
 //   3. uniqueness: registrations started ambiguity_shift_m off along x and y must come back to
 //      the same pose, or end clearly worse. Guard rails with posts, rows of parked cars and
 //      corridors align equally well at several shifts; such a place cannot tell where along
@@ -16,6 +19,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "dlslot/types.hpp"
 #include "mapper/mapper_config.hpp"
@@ -33,10 +37,17 @@ struct Registration {
   double rmse_m = 0;        // RMS distance of those inliers
 };
 
+struct RegistrationStart {
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();  // the start: the prior moved by this along the query's axes
+  Registration result;
+};
+
 struct LoopVerdict {
   bool accepted = false;
   std::string reason;  // the failed test, "" when accepted
-  Registration registration;
+  Registration registration;                         // the kept result (tests 1-3 judge it)
+  Eigen::Vector3d start_shift = Eigen::Vector3d::Zero();  // the start it came from
+  std::vector<RegistrationStart> starts;             // every start's result, the direct one first
 };
 
 // Clouds: x y z columns in each keyframe's lidar frame (intensity unused).

@@ -5,6 +5,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <chrono>
 #include <cstdio>
@@ -99,10 +100,21 @@ void printSummary(const Mapper& mapper, const std::string& out, const std::vecto
               "graph) %.2f ms mean, %.2f p95, %.1f max\n",
               mapper.keyframes().empty() ? 0.0 : mapper.keyframeMs() / mapper.keyframes().size(), loop.mean(),
               loop.percentile(95), loop.max());
-  for (const LoopEvent& e : mapper.loops().allEvents())
+  for (const LoopEvent& e : mapper.loops().allEvents()) {
     std::printf("  loop %d -> %d: %s (descriptor %.3f, inliers %.2f, rmse %.3f m)%s%s\n", e.query_frame, e.match_frame,
                 e.verdict.accepted ? "accepted" : "refused", e.descriptor_distance, e.verdict.registration.inlier_ratio,
                 e.verdict.registration.rmse_m, e.verdict.accepted ? "" : ": ", e.verdict.reason.c_str());
+    // Every registration start's result: the start (the prior shifted along the query's x, y) and
+    // where it ended (T_match_query's translation and yaw), so a wrong minimum can be seen.
+    for (const RegistrationStart& s : e.verdict.starts) {
+      const Registration& r = s.result;
+      const Eigen::Vector3d t = r.T_match_query.translation();
+      std::printf("    start %+.0f %+.0f m: inliers %.3f of %.2f supported, rmse %.3f m, at %.3f %.3f %.3f yaw %.3f deg%s%s\n",
+                  s.shift.x(), s.shift.y(), r.inlier_ratio, r.support_ratio, r.rmse_m, t.x(), t.y(), t.z(),
+                  std::atan2(r.T_match_query(1, 0), r.T_match_query(0, 0)) * 180.0 / M_PI,
+                  r.converged ? "" : ", not converged", s.shift == e.verdict.start_shift ? " (kept)" : "");
+    }
+  }
   if (!out.empty()) {
     std::printf("  wrote to %s:", out.c_str());
     for (const std::string& f : files) std::printf(" %s", f.c_str());

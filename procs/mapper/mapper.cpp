@@ -46,8 +46,12 @@ void Mapper::add(MapperInput in) {
     } else {
       last_keyframe_pose_ = in.pose;
       pending_.push_back({in.frame, in.utime, in.pose, std::move(in.scan), std::move(in.load_scan)});
+      last_scan_.reset();
     }
   }
+  // One raw scan not taken is held: the run's last one becomes a keyframe in finish().
+  if (pending_.empty() || pending_.back().frame != in.frame)
+    last_scan_ = Pending{in.frame, in.utime, in.pose, std::move(in.scan), std::move(in.load_scan), true};
   while (!pending_.empty() && pending_.front().frame <= in.frame - config_.decision_delay_frames) {
     auto job = std::make_shared<Pending>(std::move(pending_.front()));
     pending_.pop_front();
@@ -89,6 +93,10 @@ std::vector<MovingBox> Mapper::lidarBoxes(const Pending& p) const {
 }
 
 void Mapper::finish() {
+  if (last_scan_) {
+    pending_.push_back(std::move(*last_scan_));
+    last_scan_.reset();
+  }
   while (!pending_.empty()) {
     auto job = std::make_shared<Pending>(std::move(pending_.front()));
     pending_.pop_front();
@@ -189,7 +197,7 @@ void Mapper::commit(Pending& p, const std::vector<MovingBox>& boxes) {
   // loop closer's memory, like the map's, stops growing when the map does (driving in circles,
   // standing in traffic).
   const bool keep_cloud = static_cast<double>(fresh) >= config_.min_new_fraction * static_cast<double>(std::max<Eigen::Index>(nk, 1));
-  loops_->add({id, p.frame, p.pose, std::move(kept), keep_cloud});
+  loops_->add({id, p.frame, p.pose, std::move(kept), keep_cloud, p.last});
   applyLoopResult();
 }
 

@@ -76,8 +76,10 @@ class Mapper {
   // Whether a scan at `pose` (T_world_lidar) is far enough from the last keyframe to be one.
   bool needsScan(const Pose& pose) const;
   void add(MapperInput in);
-  // Takes in the keyframes still waiting for their removal decision, and waits (at normal
-  // priority) until the keyframe thread and loop closure have caught up.
+  // Takes in the keyframes still waiting for their removal decision and the run's last scan as a
+  // keyframe of its own (the scans after the last keyframe would otherwise follow SLOT's drift
+  // from it, and the end of a drive is where a loop closes: it gets its own loop edge), and waits
+  // (at normal priority) until the keyframe thread and loop closure have caught up.
   void finish();
 
   MapperSnapshot snapshot() const;
@@ -112,6 +114,7 @@ class Mapper {
     Pose pose;
     PointCloud scan;        // when given decoded
     ScanLoader load_scan;   // else this
+    bool last = false;      // the run's last scan, taken as a keyframe by finish()
   };
   // On the caller's thread: the removal boxes of a keyframe, lidar frame, with their motion.
   std::vector<MovingBox> lidarBoxes(const Pending& p) const;
@@ -125,6 +128,7 @@ class Mapper {
   std::deque<Pending> pending_;
   std::map<int, std::pair<int64_t, Pose>> frames_;  // scan -> utime, SLOT pose
   std::optional<Pose> last_keyframe_pose_;
+  std::optional<Pending> last_scan_;  // the latest scan not taken as a keyframe (finish() takes it)
   int deferred_ = 0;
   // The keyframe thread (read by the caller after finish()).
   VoxelMap map_, removed_;

@@ -78,10 +78,15 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
   l.get("max_drift_fraction", L.max_drift_fraction);
   l.get("ambiguity_shift_m", L.ambiguity_shift_m);
   l.get("ambiguity_ratio", L.ambiguity_ratio);
+  l.get("start_step_m", L.start_step_m);
+  l.get("start_steps", L.start_steps);
+  l.get("quiet_keyframes", L.quiet_keyframes);
   l.get("odometry_sigma_t", L.odometry_sigma_t);
   l.get("odometry_sigma_r", L.odometry_sigma_r);
   l.get("loop_sigma_t", L.loop_sigma_t);
   l.get("loop_sigma_r", L.loop_sigma_r);
+  if (L.start_steps < 0) throw ConfigError(l.file() + ": mapper.loop.start_steps: expected >= 0");
+  if (L.quiet_keyframes < 0) throw ConfigError(l.file() + ": mapper.loop.quiet_keyframes: expected >= 0");
   if (L.submap_keyframes < 0) throw ConfigError(l.file() + ": mapper.loop.submap_keyframes: expected >= 0");
   if (L.rings < 2 || L.sectors < 4)
     throw ConfigError(l.file() + ": mapper.loop: rings >= 2 and sectors >= 4 expected");
@@ -99,6 +104,7 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
                              {"max_rmse_m", L.max_rmse_m},
                              {"ambiguity_shift_m", L.ambiguity_shift_m},
                              {"ambiguity_ratio", L.ambiguity_ratio},
+                             {"start_step_m", L.start_step_m},
                              {"odometry_sigma_t", L.odometry_sigma_t},
                              {"odometry_sigma_r", L.odometry_sigma_r},
                              {"loop_sigma_t", L.loop_sigma_t},

@@ -21,6 +21,13 @@ struct LoopConfig {
   double inlier_distance_m = 0.3, support_distance_m = 1.0, min_inlier_ratio = 0.5, max_rmse_m = 0.25;
   double max_drift_fraction = 0.03;
   double ambiguity_shift_m = 4.0, ambiguity_ratio = 0.9;
+  // Registration starts besides the prior: shifted k x start_step_m along the query's x and y, k = 1..start_steps,
+  // those within the drift bound.
+  double start_step_m = 4.0;
+  int start_steps = 2;
+  // After an accepted loop, the next search is this many keyframes on (0: the following keyframes
+  // each verify the place again and add their own edge).
+  int quiet_keyframes = 0;
   double odometry_sigma_t = 0.02, odometry_sigma_r = 0.002;
   double loop_sigma_t = 0.1, loop_sigma_r = 0.01;
 };

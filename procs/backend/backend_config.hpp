@@ -37,7 +37,7 @@ struct BackendConfig {
   Eigen::Vector3d constant_acceleration_sigma = Eigen::Vector3d(0.005, 0.005, 0.005);
   // Marginalize the constant-acceleration factors of a leaving pose change into the prior (the
   // acceleration survives the window's slide) instead of dropping them.
-  bool marginalize_acceleration = true;
+  bool marginalize_acceleration = false;
   Vector6 first_pose_sigma = (Vector6() << 1e-3, 1e-3, 1e-3, 1e-4, 1e-4, 1e-4).finished();
   // The vehicle motion prior on every pose change of a vehicle (vehicle_motion_factor.hpp):
   // sigmas of its lateral and vertical translation (m) and roll and pitch (rad) per frame, and

@@ -315,6 +315,8 @@ std::optional<SlidingWindow::LineVelocity> SlidingWindow::boxLineVelocity(const 
 }
 
 Eigen::Vector3d SlidingWindow::youngVehicleVelocity(const Track& track, const LineVelocity& line) const {
+  // The ego's per-frame translation error: the odometry factor's sigma (eq. 8).
+  const double ego_sigma = 0.5 * (config_.odometry_sigma[0] + config_.odometry_sigma[1]);
   std::vector<VelocityEvidence> registered;
   for (const auto& [f, motion] : track.motions) {
     const auto prev = track.observations.find(f - 1);
@@ -322,8 +324,6 @@ Eigen::Vector3d SlidingWindow::youngVehicleVelocity(const Track& track, const Li
     if (prev == track.observations.end() || !a || !b) continue;
     const double dt = 1e-6 * static_cast<double>(b->utime - a->utime);
     const Eigen::Vector3d p_prev = fromBlock(a->pose->data()) * prev->second.b.translation();
-    // The ego's per-frame translation error: the odometry factor's sigma (eq. 8).
-    const double ego_sigma = 0.5 * (config_.odometry_sigma[0] + config_.odometry_sigma[1]);
     if (const auto v = registeredVelocity(motion.M, motion.information, p_prev, dt, ego_sigma)) registered.push_back(*v);
   }
   if (registered.empty()) return line.velocity;
@@ -602,15 +602,14 @@ SmoothedPose SlidingWindow::slide() {
   // (It used to cost 6x the marginalization: the kept second pose change has no rotation
   // information, the CA factor measures translations, and the singular prior went to an
   // eigen-decomposition; the Marginalizer now factorizes without such directions.)
-  factors_.erase(std::remove_if(factors_.begin(), factors_.end(),
-                                [&](const Factor& f) {
-                                  if (config_.marginalize_acceleration) return false;
-                                  if (!dynamic_cast<const ConstantAccelerationFactor*>(f.cost.get())) return false;
-                                  for (double* b : f.blocks)
-                                    if (leaving.count(b)) return true;
-                                  return false;
-                                }),
-                 factors_.end());
+  auto dropped = [&](const Factor& f) {
+    if (!dynamic_cast<const ConstantAccelerationFactor*>(f.cost.get())) return false;
+    for (double* b : f.blocks)
+      if (leaving.count(b)) return true;
+    return false;
+  };
+  if (!config_.marginalize_acceleration)
+    factors_.erase(std::remove_if(factors_.begin(), factors_.end(), dropped), factors_.end());
   marginalizeBlocks(leaving);
 
   for (auto& [id, track] : tracks_) {

@@ -152,8 +152,8 @@ LoopVerdict verifyLoop(const PointCloud& query, const PointCloud& match, const P
     v.reason = why.str();
     return v;
   }
-  const Pose change = prior.inverse() * best.T_match_query;
-  if (change.translation().norm() > max_t || angleDeg(change.rotation()) > max_r) {
+  if (!withinDrift(best.T_match_query)) {
+    const Pose change = prior.inverse() * best.T_match_query;
     why.precision(3);
     why << "drift bound: the registration moves the query " << change.translation().norm() << " m / "
         << angleDeg(change.rotation()) << " deg from the odometry's estimate (max " << max_t << " m / " << max_r

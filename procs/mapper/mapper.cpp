@@ -58,7 +58,8 @@ void Mapper::add(MapperInput in) {
     // The removal boxes are decided here (the tracks' history lives on this thread); the points are
     // handled on the keyframe thread.
     auto boxes = std::make_shared<std::vector<MovingBox>>(lidarBoxes(*job));
-    committer_->post([this, job, boxes] { commit(*job, *boxes); });
+    const BodyTwist twist = egoTwist(*job);
+    committer_->post([this, job, boxes, twist] { commit(*job, *boxes, twist); });
   }
   boxes_.forgetBefore(pending_.empty() ? in.frame - config_.decision_delay_frames : pending_.front().frame);
 }
@@ -92,6 +93,21 @@ std::vector<MovingBox> Mapper::lidarBoxes(const Pending& p) const {
   return out;
 }
 
+BodyTwist Mapper::egoTwist(const Pending& p) const {
+  // Central difference over the scans before and after (one-sided at the ends of the run): the
+  // SLOT poses are for each scan's reference instant, 0.1 s apart, so their twist is the sweep's.
+  const auto pose = [&](int frame) -> std::optional<std::pair<int64_t, Pose>> {
+    const auto it = frames_.find(frame);
+    if (it == frames_.end()) return std::nullopt;
+    return it->second;
+  };
+  const auto before = pose(p.frame - 1), after = pose(p.frame + 1);
+  const std::pair<int64_t, Pose> here{p.utime, p.pose};
+  const auto& a = before ? *before : here;
+  const auto& b = after ? *after : here;
+  return twistBetween(a.second, b.second, (b.first - a.first) * 1e-6);
+}
+
 void Mapper::finish() {
   if (last_scan_) {
     pending_.push_back(std::move(*last_scan_));
@@ -101,7 +117,8 @@ void Mapper::finish() {
     auto job = std::make_shared<Pending>(std::move(pending_.front()));
     pending_.pop_front();
     auto boxes = std::make_shared<std::vector<MovingBox>>(lidarBoxes(*job));
-    committer_->post([this, job, boxes] { commit(*job, *boxes); });
+    const BodyTwist twist = egoTwist(*job);
+    committer_->post([this, job, boxes, twist] { commit(*job, *boxes, twist); });
   }
   // The keyframe thread's catch-up feeds the loop thread: both at full speed from here.
   loops_->worker().liftLimits();
@@ -149,7 +166,7 @@ std::vector<std::string> Mapper::takeErrors() {
   return out;
 }
 
-void Mapper::commit(Pending& p, const std::vector<MovingBox>& boxes) {
+void Mapper::commit(Pending& p, const std::vector<MovingBox>& boxes, const BodyTwist& twist) {
   // CPU time of this thread: at idle priority the wall time mostly counts waiting for a core.
   const double start = threadCpuMs();
   PointCloud scan;
@@ -197,6 +214,11 @@ void Mapper::commit(Pending& p, const std::vector<MovingBox>& boxes) {
   // loop closer's memory, like the map's, stops growing when the map does (driving in circles,
   // standing in traffic).
   const bool keep_cloud = static_cast<double>(fresh) >= config_.min_new_fraction * static_cast<double>(std::max<Eigen::Index>(nk, 1));
+  // The loop closer registers keyframes from both ends of a loop, driven at different speeds and
+  // turn rates: skewed, their clouds differ by a shear that registration reads as a rotation
+  // (deskew.hpp). The map keeps the points as fired, where its removal and the evaluation's truth
+  // test them (each box at each point's firing time).
+  deskew(kept, config_.sweep, twist);
   loops_->add({id, p.frame, p.pose, std::move(kept), keep_cloud, p.last});
   applyLoopResult();
 }

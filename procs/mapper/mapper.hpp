@@ -20,6 +20,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "dlslot/deskew.hpp"
 #include "mapper/idle_worker.hpp"
 #include "mapper/loop_closer.hpp"
 #include "mapper/mapper_config.hpp"
@@ -118,8 +119,11 @@ class Mapper {
   };
   // On the caller's thread: the removal boxes of a keyframe, lidar frame, with their motion.
   std::vector<MovingBox> lidarBoxes(const Pending& p) const;
-  // On the keyframe thread: decode, crop, remove what is inside `boxes` (lidar frame), insert.
-  void commit(Pending& p, const std::vector<MovingBox>& boxes);
+  // On the caller's thread: the ego's motion over the keyframe's sweep, from its neighbouring scans.
+  BodyTwist egoTwist(const Pending& p) const;
+  // On the keyframe thread: decode, crop, remove what is inside `boxes` (lidar frame), insert;
+  // the loop closer gets the kept points de-skewed with `twist`.
+  void commit(Pending& p, const std::vector<MovingBox>& boxes, const BodyTwist& twist);
   void applyLoopResult();
 
   MapperConfig config_;

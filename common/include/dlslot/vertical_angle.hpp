@@ -1,0 +1,33 @@
+// KITTI's vertical-angle error: the HDL-64E of the KITTI recordings stores each point about 0.22 deg
+// below the ray that measured it (its intrinsic calibration; IMLS-SLAM and CT-ICP correct the
+// raw scans by it, and the simulator reproduces it: config/scenarios/README.md).
+//
+// Why it matters: a point at range r is stored r x 0.0038 too low, so the ground seen from one
+// place is a shallow cone. Two scans taken tens of metres apart see the same ground at different
+// ranges: registered, the cones fit best tilted towards each other, by about the error itself
+// (0.2-0.4 deg), and over a loop's ~38 m that is 0.15-0.3 m in height at the far end.
+#pragma once
+
+#include <cmath>
+
+#include "dlslot/types.hpp"
+
+namespace dlslot {
+
+// Raises each point's elevation (seen from the lidar's origin) by `angle_rad`, keeping its range
+// and azimuth: the stored point moved back onto its ray. 0 leaves the points.
+inline void correctElevation(PointCloud& points, double angle_rad) {
+  if (angle_rad == 0) return;
+  const float c = static_cast<float>(std::cos(angle_rad)), s = static_cast<float>(std::sin(angle_rad));
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const float x = points(0, i), y = points(1, i), z = points(2, i);
+    const float rho = std::sqrt(x * x + y * y);
+    if (rho <= 0) continue;  // straight up or down: no azimuth to keep, no lidar fires there
+    const float rho2 = rho * c - z * s;
+    points(0, i) = x * (rho2 / rho);
+    points(1, i) = y * (rho2 / rho);
+    points(2, i) = rho * s + z * c;
+  }
+}
+
+}  // namespace dlslot

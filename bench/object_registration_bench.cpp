@@ -16,6 +16,7 @@
 #include <Eigen/Eigenvalues>
 #include <random>
 
+#include "backend/object_model.hpp"
 #include "backend/object_registration.hpp"
 #include "../tests/backend_scene.hpp"
 #include "../tests/object_scan.hpp"
@@ -27,6 +28,7 @@ namespace {
 
 struct Pair {
   ObjectPoints previous, current;
+  std::vector<ObjectPoints> earlier;  // the scans before `previous`, newest first (for a model)
   Pose prediction, truth;
   Eigen::Vector3d centroid;  // of the previous points: where a result's error is measured
   double range;
@@ -43,6 +45,13 @@ std::vector<Pair> makeFrame(int objects, unsigned seed) {
     Pair p;
     p.previous = test::scanBox(o0, Eigen::Vector3d(4.5, 1.8, 1.5), Eigen::Vector3d(0, 0, 1.73), rng);
     p.current = test::scanBox(truth * o0, Eigen::Vector3d(4.5, 1.8, 1.5), Eigen::Vector3d(0, 0, 1.73), rng);
+    // Their own random numbers: the other benchmarks' cars stay as they were.
+    std::mt19937 earlier_rng(seed * 1000 + static_cast<unsigned>(out.size()));
+    Pose o = o0;
+    for (int k = 0; k < 3; ++k) {
+      o = truth.inverse() * o;
+      p.earlier.push_back(test::scanBox(o, Eigen::Vector3d(4.5, 1.8, 1.5), Eigen::Vector3d(0, 0, 1.73), earlier_rng));
+    }
     // The prediction's error about the object (as the chain's is), not about the world origin:
     // 2 deg about a point 40 m away would move the car by 1.4 m.
     const Pose o1 = truth * o0;
@@ -122,6 +131,47 @@ void BM_RegisterTwentyObjectsSixDof(benchmark::State& state) {
   registerFrame(state, options);
 }
 BENCHMARK(BM_RegisterTwentyObjectsSixDof)->Unit(benchmark::kMillisecond);
+
+// The backend with registration_model_frames > 1: each track's model of its last scans (here 4,
+// carried along by the true motions) was prepared in the previous frame (gridded only); the
+// current points are prepared (with planes), registered to the model, taken into it, and the
+// model prepared again for the next frame.
+void BM_RegisterTwentyObjectsToModels(benchmark::State& state) {
+  const std::vector<Pair> frame = makeFrame(20, 1);
+  const RegistrationOptions options;
+  RegistrationOptions model_options = options;
+  model_options.max_target_points = options.max_model_points;
+  std::vector<ObjectModel> models(frame.size());
+  std::vector<PreparedObject> prepared;
+  long model_points = 0;
+  for (size_t i = 0; i < frame.size(); ++i) {
+    const Pair& p = frame[i];
+    for (int k = static_cast<int>(p.earlier.size()) - 1; k >= -1; --k) {
+      const int f = static_cast<int>(p.earlier.size()) - 1 - k;
+      models[i].update(k >= 0 ? p.earlier[static_cast<size_t>(k)] : p.previous, f, f > 0 ? std::optional<Pose>(p.truth) : std::nullopt,
+                       p.range, options);
+    }
+    model_points += static_cast<long>(models[i].points().size());
+    prepared.emplace_back(models[i].points(), p.range, model_options, false);
+  }
+  Errors errors;
+  for (auto _ : state) {
+    errors = Errors{};
+    for (size_t i = 0; i < frame.size(); ++i) {
+      const Pair& p = frame[i];
+      const PreparedObject current(p.current, p.range, options);
+      const RegistrationResult r = registerToModel(prepared[i], current, p.prediction, options);
+      errors.add(r, p);
+      ObjectModel next = models[i];
+      next.update(p.current, models[i].frame() + 1,
+                  r.outcome == RegistrationOutcome::kMeasured ? std::optional<Pose>(r.motion) : std::nullopt, p.range, options);
+      benchmark::DoNotOptimize(PreparedObject(next.points(), p.range, model_options, false).points().data());
+    }
+  }
+  errors.report(state, frame);
+  state.counters["model_points_per_object"] = double(model_points) / frame.size();
+}
+BENCHMARK(BM_RegisterTwentyObjectsToModels)->Unit(benchmark::kMillisecond);
 
 // Both clouds prepared for each registration (no reuse from the previous frame).
 void BM_RegisterTwentyObjectsBothPrepared(benchmark::State& state) {

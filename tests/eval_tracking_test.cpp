@@ -323,6 +323,47 @@ TEST(EvalVelocity, WorldVelocitiesAreExpressedInEachScansLidarAxes) {
   EXPECT_THROW(finiteDifferenceVelocities(sensor, Side::Truth, VelocityFrame::World, true), std::invalid_argument);
 }
 
+TEST(EvalVelocity, LabelsDifferencedOverASpanAverageTheLabellersJitter) {
+  // A car accelerating at 1 m/s^2 from 2 m/s, labelled every 0.1 s, once without and once with a
+  // labeller's jitter (up to 0.1 m); the label of frame 20 is missing.
+  auto labels = [](double jitter_m) {
+    std::vector<TrackingFrame> frames(31);
+    for (int t = 0; t < 31; ++t) {
+      const double s = 0.1 * t;
+      frames[t].stamp = s;
+      frames[t].truth_pose = Pose::Identity();
+      const double j = jitter_m * (((t * 7) % 5) - 2) / 2.0;
+      if (t != 20) frames[t].truth = {obj(20 + 2 * s + 0.5 * s * s + j, 0, 1)};
+    }
+    return frames;
+  };
+  auto truth = [](int t) { return 2.0 + 0.1 * t; };
+  // Exact labels: a symmetric central difference is exact for constant acceleration, over any span.
+  std::vector<TrackingFrame> exact = labels(0.0);
+  finiteDifferenceVelocities(exact, Side::Truth, VelocityFrame::World, true, 0.5);
+  for (int t = 1; t < 30; ++t) {
+    if (t == 20) continue;
+    ASSERT_TRUE(exact[t].truth[0].velocity) << t;
+    EXPECT_NEAR(exact[t].truth[0].velocity->x(), truth(t), 1e-9) << t;
+  }
+  // Jittered labels: over +-0.5 s the labeller's noise is a fraction of the neighbours'.
+  double near_sq = 0, span_sq = 0;
+  std::vector<TrackingFrame> near = labels(0.1), span = labels(0.1);
+  finiteDifferenceVelocities(near, Side::Truth, VelocityFrame::World, true);
+  finiteDifferenceVelocities(span, Side::Truth, VelocityFrame::World, true, 0.5);
+  for (int t = 5; t <= 25; ++t) {
+    if (t == 20) continue;
+    near_sq += std::pow(near[t].truth[0].velocity->x() - truth(t), 2);
+    span_sq += std::pow(span[t].truth[0].velocity->x() - truth(t), 2);
+  }
+  EXPECT_GT(near_sq, 0.1);
+  EXPECT_LT(span_sq, 0.1 * near_sq);
+  // The span is chosen from the labels: a human's (ahead of the sensor only) or the simulator's.
+  EXPECT_EQ(labelVelocityHalfSpan(exact), 0.5);
+  exact[3].truth.push_back(obj(-15, 2, 7));
+  EXPECT_EQ(labelVelocityHalfSpan(exact), 0.0);
+}
+
 TEST(EvalVelocity, RmseOverMatchedDynamicLabels) {
   std::vector<TrackingFrame> frames(2);
   for (int t = 0; t < 2; ++t) {

@@ -114,7 +114,16 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   require(c.registration.information_scale > 0.0, s, "registration_information_scale", "a number > 0");
   s.get("registration_max_sigma", c.registration.max_sigma);
   require(c.registration.max_sigma > 0.0, s, "registration_max_sigma", "a distance > 0 (m)");
+  s.get("registration_model_frames", c.registration.model_frames);
+  require(c.registration.model_frames >= 1, s, "registration_model_frames", "an integer >= 1 (1: the previous scan alone)");
+  s.get("registration_max_model_points", c.registration.max_model_points);
+  require(c.registration.max_model_points >= c.registration.min_points, s, "registration_max_model_points",
+          "an integer >= registration_min_points");
+  s.get("registration_refine_boxes", c.registration_refine_boxes);
   s.get("registration_box_margin", c.registration_box_margin);
+  s.get("sweep_period_s", c.sweep.period_s);
+  require(c.sweep.period_s >= 0.0 && c.sweep.period_s <= 1.0, s, "sweep_period_s", "a value in [0, 1] s (0: de-skewed scans)");
+  s.get("sweep_clockwise", c.sweep.clockwise);
   require(c.registration_box_margin >= 0.0, s, "registration_box_margin", "a distance >= 0 (m)");
   s.get("registration_ground_clearance", c.registration_ground_clearance);
   require(c.registration_ground_clearance >= 0.0, s, "registration_ground_clearance", "a distance >= 0 (m)");

@@ -8,11 +8,20 @@
 namespace dlslot::backend {
 namespace {
 
-// One point per cell of edge `cell` (the first one met), then every k-th of those if more than
-// `max_points` remain. Cells, not a stride over the scan: a scan lists its points ring by ring,
-// and every k-th point of that order leaves lines, not surfaces.
 std::vector<Eigen::Vector3d> thin(const ObjectPoints& points, double cell, int max_points) {
   std::vector<Eigen::Vector3d> out;
+  const std::vector<int> kept = thinIndices(points, cell, max_points);
+  out.reserve(kept.size());
+  for (int i : kept) out.push_back(points[static_cast<size_t>(i)].cast<double>());
+  return out;
+}
+
+}  // namespace
+
+// Cells, not a stride over the scan: a scan lists its points ring by ring, and every k-th point
+// of that order leaves lines, not surfaces.
+std::vector<int> thinIndices(const ObjectPoints& points, double cell, int max_points) {
+  std::vector<int> out;
   if (points.empty()) return out;
   Eigen::Vector3d lo = points.front().cast<double>(), hi = lo;
   for (const Eigen::Vector3f& p : points) {
@@ -28,8 +37,8 @@ std::vector<Eigen::Vector3d> thin(const ObjectPoints& points, double cell, int m
   std::vector<char> taken(static_cast<size_t>(dims[0] * dims[1] * dims[2]), 0);
   out.reserve(points.size());
   const double inv_cell = 1.0 / cell;
-  for (const Eigen::Vector3f& p : points) {
-    const Eigen::Vector3d q = p.cast<double>();
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d q = points[i].cast<double>();
     long c[3];
     bool inside = true;
     for (int k = 0; k < 3; ++k) {
@@ -41,19 +50,17 @@ std::vector<Eigen::Vector3d> thin(const ObjectPoints& points, double cell, int m
     char& t = taken[static_cast<size_t>((c[2] * dims[1] + c[1]) * dims[0] + c[0])];
     if (t) continue;
     t = 1;
-    out.push_back(q);
+    out.push_back(static_cast<int>(i));
   }
   if (static_cast<int>(out.size()) > max_points) {
     const double step = static_cast<double>(out.size()) / max_points;
-    std::vector<Eigen::Vector3d> kept;
+    std::vector<int> kept;
     kept.reserve(max_points);
     for (int i = 0; i < max_points; ++i) kept.push_back(out[static_cast<size_t>(i * step)]);
     out.swap(kept);
   }
   return out;
 }
-
-}  // namespace
 
 const char* toString(RegistrationOutcome outcome) {
   switch (outcome) {
@@ -67,7 +74,7 @@ const char* toString(RegistrationOutcome outcome) {
   return "?";
 }
 
-PreparedObject::PreparedObject(const ObjectPoints& points, double range, const RegistrationOptions& o)
+PreparedObject::PreparedObject(const ObjectPoints& points, double range, const RegistrationOptions& o, bool with_planes)
     : raw_points_(static_cast<int>(points.size())) {
   voxel_ = std::max(o.min_voxel, o.voxel_per_m * range);
   if (points.empty()) return;
@@ -104,6 +111,7 @@ PreparedObject::PreparedObject(const ObjectPoints& points, double range, const R
   for (size_t i = 0; i < points_.size(); ++i) members_[next[cell[i]]++] = static_cast<int>(i);
   // The source subsample: every k-th point (the thinned points are in scan order, cell by cell),
   // each with its plane.
+  if (!with_planes) return;
   const size_t m = std::min(points_.size(), static_cast<size_t>(std::max(1, o.max_source_points)));
   const double step = static_cast<double>(points_.size()) / static_cast<double>(m);
   source_.reserve(m);
@@ -206,6 +214,27 @@ RegistrationResult registerObject(const ObjectPoints& previous, const ObjectPoin
   return registerObject(PreparedObject(previous, range, o), PreparedObject(current, range, o), prediction, o);
 }
 
+RegistrationResult inverted(const RegistrationResult& r) {
+  RegistrationResult out = r;
+  out.motion = r.motion.inverse();
+  std::swap(out.source_points, out.target_points);
+  // A perturbation (dt, dtheta) of M = (R, t) moves M^-1 by dtheta' = -R^T dtheta,
+  // dt' = -R^T dt - R^T [t]x dtheta (first order); the information follows: I = J^T I' J.
+  const Eigen::Matrix3d Rt = r.motion.linear().transpose();
+  Matrix6 J = Matrix6::Zero();
+  J.topLeftCorner<3, 3>() = -Rt;
+  J.topRightCorner<3, 3>() = -Rt * skew(r.motion.translation());
+  J.bottomRightCorner<3, 3>() = -Rt;
+  const Matrix6 Jinv = J.inverse();
+  out.information = Jinv.transpose() * r.information * Jinv;
+  return out;
+}
+
+RegistrationResult registerToModel(const PreparedObject& model, const PreparedObject& current, const Pose& prediction,
+                                   const RegistrationOptions& o) {
+  return inverted(registerObject(current, model, prediction.inverse(), o));
+}
+
 RegistrationResult registerObject(const PreparedObject& previous, const PreparedObject& current, const Pose& prediction,
                                   const RegistrationOptions& o) {
   RegistrationResult result;
@@ -222,6 +251,10 @@ RegistrationResult registerObject(const PreparedObject& previous, const Prepared
   std::vector<Eigen::Vector3d> source = previous.sourcePoints();
   for (Eigen::Vector3d& p : source) p -= c;
   const std::vector<PreparedObject::Plane>& planes = previous.sourcePlanes();
+  if (source.empty()) {
+    result.outcome = RegistrationOutcome::kPoorFit;  // prepared without planes: not a source
+    return result;
+  }
   const std::vector<Eigen::Vector3d>& target = current.points();
   const double voxel = current.voxel();
 

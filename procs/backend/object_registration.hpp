@@ -62,6 +62,11 @@ struct RegistrationOptions {
   double max_sigma = 0.03;
   double min_inlier_fraction = 0.5;  // fewer previous points with a plane within max_residual: kPoorFit
   double max_correction = 1.0;       // m: a result this far from the prediction is kDiverged
+  // The accumulated model (object_model.hpp): the object's points of up to this many consecutive
+  // scans, moved along by their registrations (1: the previous scan alone), at most
+  // max_model_points after thinning to one point per half voxel, newest first.
+  int model_frames = 5;
+  int max_model_points = 1200;
 };
 
 enum class RegistrationOutcome {
@@ -90,6 +95,10 @@ struct RegistrationResult {
 
 using ObjectPoints = std::vector<Eigen::Vector3f>;
 
+// The indices of `points` kept when thinned to one point per cell of edge `cell` (the first one
+// met in each cell), then every k-th of those if more than `max_points` remain.
+std::vector<int> thinIndices(const ObjectPoints& points, double cell, int max_points);
+
 // One scan's points of an object, prepared for registration (world frame): as the target of
 // this frame's registration and as the source of the next frame's.
 class PreparedObject {
@@ -99,9 +108,10 @@ class PreparedObject {
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   };
 
-  // `points`: the object's points of one scan, world frame; `range`: its distance from the sensor
-  // (m), which sets the voxel size.
-  PreparedObject(const ObjectPoints& points, double range, const RegistrationOptions& options);
+  // `points`: the object's points of one scan (or its model), world frame; `range`: its distance
+  // from the sensor (m), which sets the voxel size. `with_planes` false: a target only (no source
+  // subsample, no plane fits), when the source is the object's model.
+  PreparedObject(const ObjectPoints& points, double range, const RegistrationOptions& options, bool with_planes = true);
 
   int rawPoints() const { return raw_points_; }
   double voxel() const { return voxel_; }
@@ -135,6 +145,17 @@ class PreparedObject {
 // predicted M.
 RegistrationResult registerObject(const PreparedObject& previous, const PreparedObject& current, const Pose& prediction,
                                   const RegistrationOptions& options);
+// The same motion M (previous -> current) measured against the object's accumulated model of the
+// previous scans (object_model.hpp, world frame of the previous scan): the current scan's points
+// (the source, with their planes) registered to the model's (the target, `model` prepared
+// without planes), and the result turned round. This way round every current point has the
+// model's points around it (the model holds the previous scan and more), where the model's points
+// as the source would look for counterparts of faces and ring heights the current scan does not
+// have and count them as a poor fit.
+RegistrationResult registerToModel(const PreparedObject& model, const PreparedObject& current, const Pose& prediction,
+                                   const RegistrationOptions& options);
+// M^-1 with its information: in the tangent at M^-1 (as for M: t + dt, Exp(dtheta) R).
+RegistrationResult inverted(const RegistrationResult& r);
 // The same from the raw points (both prepared here, at the same range).
 RegistrationResult registerObject(const ObjectPoints& previous, const ObjectPoints& current, const Pose& prediction,
                                   double range, const RegistrationOptions& options);

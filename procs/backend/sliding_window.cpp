@@ -232,17 +232,59 @@ bool SlidingWindow::registers(const std::string& type) const {
 
 void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, int frame, const Pose& X, BackendOutput& out) {
   if (!obs.points || !registers(track.type)) return;
+  const RegistrationOptions& options = config_.registration;
+  // Each point is in the lidar frame of its firing, t seconds from the reference instant: the
+  // lidar had moved by the ego's motion (its twist over the last frame, lidar frame), the object
+  // by its velocity (its last estimate, else its boxes' displacement). Both undone to first order
+  // in t, so the points sit where the object's box (and pose) is at the reference instant.
+  Eigen::Vector3d v_ego = Eigen::Vector3d::Zero(), w_ego = Eigen::Vector3d::Zero(), v_obj = Eigen::Vector3d::Zero();
+  const EgoFrame* prev_ego = findFrame(frame - 1);
+  const double frame_dt = prev_ego ? 1e-6 * static_cast<double>(frames_.back().utime - prev_ego->utime) : 0.0;
+  const auto prev_obs = track.observations.find(frame - 1);
+  if (config_.sweep.period_s > 0 && frame_dt > 0) {
+    const Pose X_prev = fromBlock(prev_ego->pose->data());
+    const Vector6 twist = logPose(X_prev.inverse() * X) / frame_dt;  // frame t-1's axes ~ frame t's
+    v_ego = twist.head<3>();
+    w_ego = twist.tail<3>();
+    if (track.velocity) {
+      v_obj = X.linear().transpose() * *track.velocity;
+    } else if (prev_obs != track.observations.end()) {
+      v_obj = X.linear().transpose() *
+              ((X * track.observations.at(frame).b).translation() - (X_prev * prev_obs->second.b).translation()) / frame_dt;
+    }
+  }
   ObjectPoints world;
   world.reserve(obs.points->size());
-  for (const Eigen::Vector3f& p : *obs.points) world.push_back((X * p.cast<double>()).cast<float>());
+  for (const Eigen::Vector3f& pf : *obs.points) {
+    Eigen::Vector3d p = pf.cast<double>();
+    const double t = config_.sweep.firingTime(p.x(), p.y());
+    p += t * (w_ego.cross(p) + v_ego - v_obj);
+    world.push_back((X * p).cast<float>());
+  }
   const std::shared_ptr<const PreparedObject> previous = track.points;
   const int previous_frame = track.points_frame;
-  // Prepared once: this frame's target, the next frame's source.
-  const auto current = std::make_shared<const PreparedObject>(world, obs.box.center.norm(), config_.registration);
-  track.points = current;
-  track.points_frame = frame;
+  const double range = obs.box.center.norm();
+  // This scan prepared once (thinned, gridded, its planes). Without a model: this frame's target
+  // and the next frame's source. With one: this frame's source, registered to the model of the
+  // previous scans (the target, gridded only, as dense as the model is bounded), which then takes
+  // this scan in.
+  const bool with_model = options.model_frames > 1;
+  const auto current = std::make_shared<const PreparedObject>(world, range, options);
+  std::optional<Pose> measured;
+  const auto keep = [&] {
+    track.points_frame = frame;
+    track.accumulated.update(world, frame, measured, range, options);  // also the refined box's points
+    if (!with_model) {
+      track.points = current;
+      return;
+    }
+    RegistrationOptions model_options = options;
+    model_options.max_target_points = options.max_model_points;
+    track.points = std::make_shared<const PreparedObject>(track.accumulated.points(), range, model_options, false);
+  };
   if (!previous || previous_frame != frame - 1) {
     ++out.registration_no_previous;
+    keep();
     return;
   }
   // The prediction: the chain's latest pose change carried to the world at o_{t-1}, else the
@@ -250,8 +292,6 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
   // registration's reach).
   Pose M0 = Pose::Identity();
   const auto o_prev = track.poses.find(frame - 1);
-  const auto prev_obs = track.observations.find(frame - 1);
-  const EgoFrame* prev_ego = findFrame(frame - 1);
   if (track.model == TrackModel::kDynamic && o_prev != track.poses.end() && !track.changes.empty()) {
     const Pose o = fromBlock(o_prev->second->data());
     M0 = o * fromBlock(track.changes.rbegin()->second->data()) * o.inverse();
@@ -259,11 +299,17 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
     M0.translation() = (X * track.observations.at(frame).b).translation() -
                        (fromBlock(prev_ego->pose->data()) * prev_obs->second.b).translation();
   }
-  const RegistrationResult r = registerObject(*previous, *current, M0, config_.registration);
+  const RegistrationResult r =
+      with_model ? registerToModel(*previous, *current, M0, options) : registerObject(*previous, *current, M0, options);
   ++out.registrations[static_cast<int>(r.outcome)];
   out.registration_points += r.source_points;
   if (r.ok()) out.registration_residual_sq += r.rms_residual * r.rms_residual;
   if (r.ok()) track.motions[frame] = Track::Motion{r.motion, r.information};
+  // Only a full measurement carries the model along: a partial one's unmeasured direction is the
+  // prediction's (decimetres off), and older points moved by it would smear the model along the
+  // face it could not see.
+  if (r.outcome == RegistrationOutcome::kMeasured) measured = r.motion;
+  keep();
 }
 
 std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track) const {
@@ -566,6 +612,14 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
       if (track.reversed) e.pose.linear() = e.pose.linear() * Eigen::Vector3d(-1, -1, 1).asDiagonal();
     }
     if (block) e.covariance = covariance(block);
+    // The published box made to cover the object's accumulated points of this frame (a partly
+    // seen car's size and centre); the graph keeps its own estimate.
+    if (config_.registration_refine_boxes && registers(track.type) && track.accumulated.frame() == t) {
+      const RefinedBox r = refinedBox(e.pose, e.size, track.accumulated.points(),
+                                      fromBlock(frames_.back().pose->data()).translation(), config_.registration.min_points);
+      e.pose = r.pose;
+      e.size = r.size;
+    }
     out.tracks.push_back(std::move(e));
   }
 }

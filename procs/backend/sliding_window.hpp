@@ -22,6 +22,7 @@
 #include "backend/factor.hpp"
 #include "backend/marginalizer.hpp"
 #include "backend/motion_evidence.hpp"
+#include "backend/object_model.hpp"
 #include "backend/pose_manifold.hpp"
 #include "backend/window_solver.hpp"
 
@@ -75,9 +76,11 @@ class SlidingWindow {
     std::optional<Eigen::Vector3d> velocity;
     bool velocity_from_chain = false;
     bool reversed = false;  // its boxes' heading points backwards: published turned by pi (fillTracks)
-    // Per-object registration: the object's points of its latest scan (world frame, prepared:
-    // the next frame's previous points), and the motions measured between consecutive scans
+    // Per-object registration: the object's accumulated points (its model, world frame of its
+    // latest scan) and the same prepared as the next frame's source (the latest scan alone when
+    // registration_model_frames is 1), and the motions measured between consecutive scans
     // (frame t -> M of t-1 -> t, world frame).
+    ObjectModel accumulated;
     std::shared_ptr<const PreparedObject> points;
     int points_frame = -1;
     struct Motion {
@@ -94,7 +97,8 @@ class SlidingWindow {
   OdometryCheck checkOdometryFactor(const BackendInput& in, const Pose& delta, const Matrix6& S) const;
   void addObservations(const BackendInput& in, BackendOutput& out);
   void startTrack(Track& track, int frame);
-  // Registers the object's points of this frame to those of the previous one (when it has both).
+  // Registers the object's points of this frame to its model of the previous ones (or to the
+  // previous scan alone, registration_model_frames 1), when it has both, and takes them into it.
   void registerPoints(Track& track, const ObservationInput& obs, int frame, const Pose& X, BackendOutput& out);
   bool registers(const std::string& type) const;
   // The velocity of the line through the track's boxes in the window (windowMotion), for a

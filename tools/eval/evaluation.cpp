@@ -18,29 +18,33 @@ namespace {
 
 // Labels and tracks get velocities the same way, in the world when both sides have poses,
 // else relative to the sensor. Returns how they were compared, for the report.
-std::string assignVelocities(RunData& run, double dynamic_speed_mps) {
+std::string assignVelocities(RunData& run, double dynamic_speed_mps, double label_half_span_s) {
   auto& frames = run.tracking;
   const bool truth_world = std::all_of(frames.begin(), frames.end(), [](const TrackingFrame& f) { return f.truth_pose.has_value(); });
   const bool tracks_world = run.track_velocities_given ||
                             std::all_of(frames.begin(), frames.end(), [](const TrackingFrame& f) { return f.ego_pose.has_value(); });
-  char speed[32];
+  char speed[32], span[96];
   std::snprintf(speed, sizeof speed, "%g", dynamic_speed_mps);
+  if (label_half_span_s > 0)
+    std::snprintf(span, sizeof span, "central differences over +-%g s of the labelled positions", label_half_span_s);
+  else
+    std::snprintf(span, sizeof span, "differences of consecutive labelled positions");
   std::string how;
   if (truth_world && tracks_world) {
-    finiteDifferenceVelocities(frames, Side::Truth, VelocityFrame::World, true);
+    finiteDifferenceVelocities(frames, Side::Truth, VelocityFrame::World, true, label_half_span_s);
     finiteDifferenceVelocities(frames, Side::Tracks, VelocityFrame::World, false);
     markDynamicLabels(frames, VelocityFrame::World, dynamic_speed_mps);
-    how = "world frame (velocity over ground, compared in each scan's lidar axes); labels: differences of "
-          "consecutive labelled positions put in the world with the ground-truth poses; tracks: " +
+    how = "world frame (velocity over ground, compared in each scan's lidar axes); labels: " + std::string(span) +
+          " put in the world with the ground-truth poses; tracks: " +
           std::string(run.track_velocities_given ? "the system's own velocity estimates"
                                                  : "differences of positions put in the world with the system's poses") +
           "; dynamic = labels whose mean speed over their life is >= " + speed + " m/s";
   } else {
-    finiteDifferenceVelocities(frames, Side::Truth, VelocityFrame::Sensor, true);
+    finiteDifferenceVelocities(frames, Side::Truth, VelocityFrame::Sensor, true, label_half_span_s);
     finiteDifferenceVelocities(frames, Side::Tracks, VelocityFrame::Sensor, true);
     markDynamicLabels(frames, VelocityFrame::Sensor, dynamic_speed_mps);
-    how = "sensor frame (no ground-truth poses): velocity relative to the sensor, from differences of consecutive "
-          "positions in the lidar frames, for labels and tracks alike; every matched label counts";
+    how = "sensor frame (no ground-truth poses): velocity relative to the sensor; labels: " + std::string(span) +
+          " in the lidar frames; tracks: differences of consecutive positions; every matched label counts";
   }
   return how;
 }
@@ -73,7 +77,9 @@ Metrics evaluate(RunData run, const EvalOptions& options) {
   }
   if (run.has_labels && run.has_tracks) {
     restrictClasses(run.tracking, options.classes);
-    m.velocity_frame = assignVelocities(run, options.dynamic_speed_mps);
+    m.label_velocity_half_span_s = options.label_velocity_half_span_s >= 0 ? options.label_velocity_half_span_s
+                                                                            : labelVelocityHalfSpan(run.tracking);
+    m.velocity_frame = assignVelocities(run, options.dynamic_speed_mps, m.label_velocity_half_span_s);
     m.tracking = trackingMetrics(run.tracking, options.distance);
     m.tracking_iou = trackingMetrics(run.tracking, options.iou);
     for (const auto& [cls, name] : {std::pair{"car", "Car"}, {"pedestrian", "Pedestrian"}, {"cyclist", "Cyclist"}}) {

@@ -55,6 +55,9 @@ struct EvalOptions {
   MatchCriterion distance;                                              // CLEAR MOT / HOTA, first line
   MatchCriterion iou{MatchCriterion::Kind::Iou3d};                      // second line
   double dynamic_speed_mps = 0.5;  // labels moving at least this fast count for the velocity RMSE
+  // The labels' velocities are central differences over at most +- this (velocity.hpp); < 0:
+  // chosen from the labels (labelVelocityHalfSpan).
+  double label_velocity_half_span_s = -1.0;
   std::vector<std::string> classes;  // evaluated classes; empty = all
   KittiProtocolOptions kitti;
 };
@@ -76,6 +79,7 @@ struct Metrics {
   std::map<std::string, ClearMot> tracking_by_class;
   std::map<std::string, KittiClassMetrics> kitti;           // the KITTI protocol per class; empty without it
   std::string velocity_frame;                               // how velocities were compared
+  double label_velocity_half_span_s = 0.0;                  // the labels' central differences: +- this (0: neighbours)
   std::map<std::string, TimingStats> timing_ms;
   std::map<std::string, int64_t> frame_counts;
   std::vector<std::string> notes;

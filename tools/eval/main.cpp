@@ -40,7 +40,7 @@ struct Options {
   std::string out, export_dir;
   std::string map_dir;
   std::string classes;
-  double match_distance = 2.0, min_iou = 0.25, dynamic_speed = 0.5, frame_period = 0.1;
+  double match_distance = 2.0, min_iou = 0.25, dynamic_speed = 0.5, frame_period = 0.1, label_velocity_span = -1;
   double image_width = kitti::ImageSize().width, image_height = kitti::ImageSize().height;
   int track_max_unseen = 0;
   bool allow_missing_truth = false, quiet = false;
@@ -402,6 +402,9 @@ int run(int argc, char** argv) {
   cl.option("--match-distance", &o.match_distance, "centre-distance gate in metres (default 2)");
   cl.option("--min-iou", &o.min_iou, "3D IoU gate of the second line and of the KITTI protocol (default 0.25)");
   cl.option("--dynamic-speed", &o.dynamic_speed, "labels at least this fast (m/s) are dynamic (default 0.5)");
+  cl.option("--label-velocity-span", &o.label_velocity_span,
+            "labels' velocities: central differences over at most +- this many seconds (default: 0.5 for a "
+            "human's labels, which jitter; neighbouring frames for the simulator's exact ones)");
   cl.option("--track-max-unseen", &o.track_max_unseen,
             "SLOT_STATE tracks not observed for more frames than this are not output (default 0)");
   cl.option("--image-width", &o.image_width, "image_02 width in pixels for 2-D boxes (default 1242)");
@@ -517,6 +520,7 @@ int run(int argc, char** argv) {
   opt.distance.max_distance_m = o.match_distance;
   opt.iou.min_iou = o.min_iou;
   opt.dynamic_speed_mps = o.dynamic_speed;
+  opt.label_velocity_half_span_s = o.label_velocity_span;
   opt.classes = splitList(o.classes);
   opt.kitti.min_iou = o.min_iou;
   opt.kitti.classes = kittiClasses(opt.classes);

@@ -249,6 +249,7 @@ std::string metricsJson(const Metrics& m) {
   kv.emplace_back("ego.odometry_max_disagreement_m", num(oc ? Opt(oc->max_disagreement_m) : std::nullopt));
   for (const auto& [name, e] : m.ego) ego_entries("sources." + name + ".", e);
   for (const auto& [key, v] : trackingValues(m.tracking)) kv.emplace_back("tracking." + key, num(v));
+  kv.emplace_back("tracking.label_velocity_half_span_s", num(m.tracking ? Opt(m.label_velocity_half_span_s) : std::nullopt));
   for (const auto& [key, v] : trackingValues(m.tracking_iou)) kv.emplace_back("tracking_iou." + key, num(v));
   for (const auto& [cls, c] : m.tracking_by_class) {
     const std::string k = "tracking_all_around." + cls + ".";

@@ -1,5 +1,6 @@
 #include "velocity.hpp"
 
+#include <algorithm>
 #include <map>
 #include <stdexcept>
 
@@ -15,7 +16,7 @@ const std::optional<Pose>& poseOf(const TrackingFrame& f, Side side) {
 }  // namespace
 
 void finiteDifferenceVelocities(std::vector<TrackingFrame>& frames, Side side, VelocityFrame velocity_frame,
-                                bool overwrite) {
+                                bool overwrite, double half_span_s) {
   const bool world = velocity_frame == VelocityFrame::World;
   // Position of every object by frame and id, in the frame the differences are taken in.
   std::vector<std::map<int, Eigen::Vector3d>> positions(frames.size());
@@ -29,10 +30,18 @@ void finiteDifferenceVelocities(std::vector<TrackingFrame>& frames, Side side, V
   for (size_t t = 0; t < frames.size(); ++t) {
     for (Object& o : objects(frames[t], side)) {
       if (o.velocity && !overwrite) continue;
-      // The neighbours that saw the same object; a missing side makes it one-sided.
+      // The widest symmetric span within half_span_s whose ends saw the object; else the
+      // neighbours that saw it (a missing side makes it one-sided).
       size_t a = t, b = t;
-      if (t > 0 && positions[t - 1].count(o.box.id)) a = t - 1;
-      if (t + 1 < frames.size() && positions[t + 1].count(o.box.id)) b = t + 1;
+      for (size_t k = 1; k <= t && t + k < frames.size(); ++k) {
+        const double half = std::max(frames[t].stamp - frames[t - k].stamp, frames[t + k].stamp - frames[t].stamp);
+        if (half > half_span_s + 1e-9) break;
+        if (positions[t - k].count(o.box.id) && positions[t + k].count(o.box.id)) a = t - k, b = t + k;
+      }
+      if (a == b) {
+        if (t > 0 && positions[t - 1].count(o.box.id)) a = t - 1;
+        if (t + 1 < frames.size() && positions[t + 1].count(o.box.id)) b = t + 1;
+      }
       const double dt = frames[b].stamp - frames[a].stamp;
       if (a == b || !(dt > 0)) {
         o.velocity.reset();
@@ -43,6 +52,13 @@ void finiteDifferenceVelocities(std::vector<TrackingFrame>& frames, Side side, V
       o.velocity = v.head<2>();
     }
   }
+}
+
+double labelVelocityHalfSpan(const std::vector<TrackingFrame>& frames) {
+  for (const TrackingFrame& f : frames)
+    for (const Object& o : f.truth)
+      if (o.box.center.x() < 0) return 0.0;
+  return 0.5;
 }
 
 void markDynamicLabels(std::vector<TrackingFrame>& frames, VelocityFrame velocity_frame, double min_speed_mps) {

@@ -218,8 +218,9 @@ RegistrationResult inverted(const RegistrationResult& r) {
   RegistrationResult out = r;
   out.motion = r.motion.inverse();
   std::swap(out.source_points, out.target_points);
-  // A perturbation (dt, dtheta) of M = (R, t) moves M^-1 by dtheta' = -R^T dtheta,
-  // dt' = -R^T dt - R^T [t]x dtheta (first order); the information follows: I = J^T I' J.
+  // A perturbation d = (dt, dtheta) of M = (R, t) moves M^-1 by d' = J d: dtheta' = -R^T dtheta,
+  // dt' = -R^T dt - R^T [t]x dtheta (first order). The same Mahalanobis length d^T I d = d'^T I' d'
+  // gives I' = J^-T I J^-1.
   const Eigen::Matrix3d Rt = r.motion.linear().transpose();
   Matrix6 J = Matrix6::Zero();
   J.topLeftCorner<3, 3>() = -Rt;

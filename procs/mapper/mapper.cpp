@@ -215,14 +215,16 @@ void Mapper::commit(Pending& p, const std::vector<MovingBox>& boxes, const BodyT
   // loop closer's memory, like the map's, stops growing when the map does (driving in circles,
   // standing in traffic).
   const bool keep_cloud = static_cast<double>(fresh) >= config_.min_new_fraction * static_cast<double>(std::max<Eigen::Index>(nk, 1));
-  // The loop closer registers keyframes tens of metres apart, driven at different speeds and turn
-  // rates: each point is put back on its ray (vertical_angle.hpp: uncorrected, the two sides' ground
-  // cones fit best tilted) and then into the frame of the scan's reference instant (deskew.hpp:
-  // skewed, the two sides differ by a shear that registration reads as a rotation). The map keeps
-  // the points as stored, where its removal and the evaluation's truth test them (each box at each
-  // point's firing time, each map point one of its scan's).
-  correctElevation(kept, config_.vertical_angle_error_rad);
-  deskew(kept, config_.sweep, twist);
+  // With loop.correct_clouds: the loop closer registers keyframes tens of metres apart, driven at
+  // different speeds and turn rates; each point is put back on its ray (vertical_angle.hpp:
+  // uncorrected, the two sides' ground cones fit best tilted) and then into the frame of the scan's
+  // reference instant (deskew.hpp: skewed, the two sides differ by a shear that registration reads
+  // as a rotation). The map keeps the points as stored, where its removal and the evaluation's
+  // truth test them (each box at each point's firing time, each map point one of its scan's).
+  if (config_.loop.correct_clouds) {
+    correctElevation(kept, config_.vertical_angle_error_rad);
+    deskew(kept, config_.sweep, twist);
+  }
   loops_->add({id, p.frame, p.pose, std::move(kept), keep_cloud, p.last});
   applyLoopResult();
 }

@@ -67,6 +67,7 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
   ConfigSection l = s.section("loop");
   LoopConfig& L = c.loop;
   l.get("enabled", L.enabled);
+  l.get("correct_clouds", L.correct_clouds);
   l.get("rings", L.rings);
   l.get("sectors", L.sectors);
   l.get("max_radius_m", L.max_radius_m);

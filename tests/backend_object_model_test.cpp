@@ -22,12 +22,6 @@ namespace {
 const Eigen::Vector3d kSensor(0, 0, 1.73);
 const Eigen::Vector3d kCar(4.5, 1.8, 1.5);
 
-// How many horizontal directions the result measured (information above 1 / (3 cm)^2).
-int measuredDirections(const RegistrationResult& r) {
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(r.information.topLeftCorner<2, 2>());
-  return (es.eigenvalues().array() > 1.0 / (0.03 * 0.03)).count();
-}
-
 struct Outcomes {
   RegistrationResult pair, model;
 };
@@ -142,8 +136,11 @@ TEST(ObjectModel, RegistersTheNextScanToTheModel) {
     const Pose truth = o(4) * o(3).inverse();
     const Eigen::Vector2d e = (r.model.motion * o(3).translation() - truth * o(3).translation()).head<2>();
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(r.model.information.topLeftCorner<2, 2>());
-    for (int k = 0; k < 2; ++k)
-      if (es.eigenvalues()[k] > 1.0 / (0.03 * 0.03)) EXPECT_LT(std::abs(es.eigenvectors().col(k).dot(e)), 0.02);
+    for (int k = 0; k < 2; ++k) {
+      if (es.eigenvalues()[k] > 1.0 / (0.03 * 0.03)) {
+        EXPECT_LT(std::abs(es.eigenvectors().col(k).dot(e)), 0.02);
+      }
+    }
     measured += r.model.outcome == RegistrationOutcome::kMeasured;
   }
   EXPECT_GE(measured, 1);

@@ -1,6 +1,7 @@
 // Strict YAML config: missing, ill-typed and unknown keys are errors naming file and key.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -131,4 +132,20 @@ TEST(Config, NanIsRefusedNamingTheKey) {
     e = errorOf([&] { s.get<std::vector<double>>("list"); });
     EXPECT_NE(e.find("odometry.list (line 3): expected a number, got a list with .nan"), std::string::npos) << e;
   }
+}
+
+TEST(Config, TheLidarSectionIsReadOnceForEveryProcess) {
+  Channels c;
+  ConfigSection root = loadPipelineConfig(std::string(DLSLOT_SOURCE_DIR) + "/config/dlslot.yaml", c);
+  const LidarConfig lidar = LidarConfig::read(root.section("lidar"));
+  EXPECT_DOUBLE_EQ(lidar.sweep.period_s, 0.1);
+  EXPECT_TRUE(lidar.sweep.clockwise);
+  EXPECT_NEAR(lidar.vertical_angle_error_rad, 0.22 * M_PI / 180.0, 1e-12);
+  // A value out of range, and a key that belongs elsewhere, are errors naming the file and the key.
+  const std::string bad = writeYaml("cfg_lidar.yaml", "lidar:\n  sweep_period_s: 2\n  sweep_clockwise: true\n  vertical_angle_error_deg: 0\n");
+  const std::string e = errorOf([&] { LidarConfig::read(loadConfig(bad).section("lidar")); });
+  EXPECT_NE(e.find("cfg_lidar.yaml: lidar.sweep_period_s: expected a value in [0, 1] s"), std::string::npos) << e;
+  const std::string extra = writeYaml("cfg_lidar2.yaml",
+                                      "lidar:\n  sweep_period_s: 0\n  sweep_clockwise: true\n  vertical_angle_error_deg: 0\n  min_range_m: 2\n");
+  EXPECT_NE(errorOf([&] { LidarConfig::read(loadConfig(extra).section("lidar")); }).find("min_range_m"), std::string::npos);
 }

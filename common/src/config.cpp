@@ -1,12 +1,11 @@
 #include "dlslot/config.hpp"
 
-#include <iterator>
-
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 
 namespace dlslot {
 namespace {
@@ -170,9 +169,26 @@ void Channels::read(ConfigSection s) {
   s.finish();
 }
 
+LidarConfig LidarConfig::read(ConfigSection s) {
+  LidarConfig c;
+  s.get("sweep_period_s", c.sweep.period_s);
+  if (!(c.sweep.period_s >= 0 && c.sweep.period_s <= 1.0))
+    throw ConfigError(s.file() + ": " + s.path() + ".sweep_period_s: expected a value in [0, 1] s (0: de-skewed scans)");
+  s.get("sweep_clockwise", c.sweep.clockwise);
+  double vertical_deg = 0;
+  s.get("vertical_angle_error_deg", vertical_deg);
+  if (!(std::abs(vertical_deg) <= 5.0))
+    throw ConfigError(s.file() + ": " + s.path() + ".vertical_angle_error_deg: expected a value in [-5, 5] deg, got " +
+                      std::to_string(vertical_deg));
+  c.vertical_angle_error_rad = vertical_deg * M_PI / 180.0;
+  s.finish();
+  return c;
+}
+
 ConfigSection loadPipelineConfig(const std::string& file, Channels& channels) {
   ConfigSection root = loadConfig(file);
-  for (const char* section : {"channels", "player", "detector", "odometry", "tracker", "backend", "renderer", "mapper"}) root.skip(section);
+  for (const char* section : {"channels", "lidar", "player", "detector", "odometry", "tracker", "backend", "renderer", "mapper"})
+    root.skip(section);
   root.finish();
   channels.read(root.section("channels"));
   return root;

@@ -121,9 +121,6 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
           "an integer >= registration_min_points");
   s.get("registration_refine_boxes", c.registration_refine_boxes);
   s.get("registration_box_margin", c.registration_box_margin);
-  s.get("sweep_period_s", c.sweep.period_s);
-  require(c.sweep.period_s >= 0.0 && c.sweep.period_s <= 1.0, s, "sweep_period_s", "a value in [0, 1] s (0: de-skewed scans)");
-  s.get("sweep_clockwise", c.sweep.clockwise);
   require(c.registration_box_margin >= 0.0, s, "registration_box_margin", "a distance >= 0 (m)");
   s.get("registration_ground_clearance", c.registration_ground_clearance);
   require(c.registration_ground_clearance >= 0.0, s, "registration_ground_clearance", "a distance >= 0 (m)");

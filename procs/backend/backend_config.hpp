@@ -70,9 +70,9 @@ struct BackendConfig {
   // The points taken for an object (the node's selection): its box grown by this margin (m) on
   // every side but the bottom, which is raised this far above the box's floor (the ground).
   double registration_box_margin = 0.2;
-  // The scans are not de-skewed (sweep_timing.hpp): a registered object's points are moved to the
-  // scan's reference instant (its pose's, its boxes') by the ego's motion and the object's over
-  // the time from their firing. period 0: de-skewed scans.
+  // The scans' firing order, from the config's lidar section (LidarConfig): a registered object's
+  // points are moved to the scan's reference instant (its pose's, its boxes') by the ego's motion
+  // and the object's over the time from their firing. period 0: de-skewed scans.
   SweepTiming sweep;
   double registration_ground_clearance = 0.3;
   // Publish each registered vehicle's box made to cover its accumulated points (object_model.hpp,

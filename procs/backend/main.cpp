@@ -346,6 +346,7 @@ int main(int argc, char** argv) {
     ConfigSection root = loadPipelineConfig(opts.config, channels);
     ConfigSection section = root.section("backend");
     BackendConfig config = BackendConfig::read(section);
+    config.sweep = LidarConfig::read(root.section("lidar")).sweep;
     double join_timeout_s = 0;
     section.get("join_timeout_s", join_timeout_s);
     if (!(join_timeout_s > 0)) throw ConfigError(opts.config + ": backend.join_timeout_s: expected a time > 0 (s)");

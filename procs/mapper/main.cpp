@@ -300,6 +300,9 @@ int main(int argc, char** argv) {
     ConfigSection section = root.section("mapper");
     MapperConfig config = MapperConfig::read(section);
     section.finish();
+    const LidarConfig lidar = LidarConfig::read(root.section("lidar"));
+    config.sweep = lidar.sweep;
+    config.vertical_angle_error_rad = lidar.vertical_angle_error_rad;
     if (!remove.empty()) config.remove_movable = remove == "movable";
     if (no_loops) config.loop.enabled = false;
     config.join_timeout_s = join_timeout.resolve(config.join_timeout_s);

@@ -25,16 +25,6 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
   c.remove_movable = remove == "movable";
   s.get("box_margin_m", c.box_margin_m);
   s.get("ground_clearance_m", c.ground_clearance_m);
-  s.get("sweep_period_s", c.sweep.period_s);
-  s.get("sweep_clockwise", c.sweep.clockwise);
-  if (!(c.sweep.period_s >= 0 && c.sweep.period_s <= 1.0))
-    throw ConfigError(s.file() + ": " + s.path() + ".sweep_period_s: expected a value in [0, 1] s (0: de-skewed scans)");
-  double vertical_deg = 0;
-  s.get("vertical_angle_error_deg", vertical_deg);
-  if (!(std::abs(vertical_deg) <= 5.0))
-    throw ConfigError(s.file() + ": " + s.path() + ".vertical_angle_error_deg: expected a value in [-5, 5] deg, got " +
-                      std::to_string(vertical_deg));
-  c.vertical_angle_error_rad = vertical_deg * M_PI / 180.0;
   s.get("min_new_fraction", c.min_new_fraction);
   s.get("decision_delay_frames", c.decision_delay_frames);
   s.get("follow_frames", c.follow_frames);

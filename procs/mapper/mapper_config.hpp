@@ -43,11 +43,10 @@ struct MapperConfig {
   bool remove_movable = false;  // remove: movable (every track) instead of dynamic (moving tracks)
   double box_margin_m = 0.7;
   double ground_clearance_m = 0.1;
-  // The scans' firing order: a moving object's points lie in its box moved by its motion relative to
-  // the lidar until the instant they were fired (sweep_timing.hpp); period 0: de-skewed scans.
+  // From the config's lidar section (LidarConfig): the scans' firing order (a moving object's points
+  // lie in its box moved by its motion relative to the lidar until the instant they were fired), and
+  // how far below its ray each point is stored (the loop closer's clouds may be corrected by it).
   SweepTiming sweep;
-  // How far below its ray the lidar stores each point (KITTI's HDL-64E: 0.22 deg), rad; the loop
-  // closer's clouds are corrected by it (vertical_angle.hpp). 0: none.
   double vertical_angle_error_rad = 0.0;
   double min_new_fraction = 0.01;  // a keyframe keeps its loop-closure cloud when this share of its points made new voxels
   int decision_delay_frames = 15, follow_frames = 15;

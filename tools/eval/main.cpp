@@ -300,8 +300,7 @@ void addMap(const Options& o, const DataSet& data, RunData& run) {
     mapper.get("map_voxel_m", opt.voxel_m);
     mapper.get("min_range_m", opt.min_range_m);
     mapper.get("max_range_m", opt.max_range_m);
-    mapper.get("sweep_period_s", opt.sweep.period_s);
-    mapper.get("sweep_clockwise", opt.sweep.clockwise);
+    opt.sweep = LidarConfig::read(root.section("lidar")).sweep;
   }
   mm.score.voxel_m = opt.voxel_m;
   if (!o.kitti_root.empty()) {

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "dlslot/sweep_timing.hpp"
+
 namespace dlslot {
 
 class ConfigError : public std::runtime_error {
@@ -80,6 +82,14 @@ struct Channels {
   // Reads the section; every channel must have a name of its own: two roles on one channel (e.g.
   // odometry: SLOT_STATE) would feed one process's output to another as a different type.
   void read(ConfigSection section);
+};
+
+// How the scans were taken (section `lidar`): properties of the data, one place for every process
+// that uses raw points (the back end's object registration, the mapper, dlslot-eval --map).
+struct LidarConfig {
+  SweepTiming sweep;                      // sweep_period_s (0: de-skewed scans), sweep_clockwise
+  double vertical_angle_error_rad = 0.0;  // vertical_angle_error_deg: how far below its ray each point is stored
+  static LidarConfig read(ConfigSection section);
 };
 
 // Loads the pipeline's one config file for a process: every top-level key must be one of the

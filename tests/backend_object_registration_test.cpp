@@ -16,12 +16,11 @@
 using namespace dlslot;
 using namespace dlslot::backend;
 using dlslot::backend::test::planarPose;
+using dlslot::backend::test::kCar;
+using dlslot::backend::test::kSensor;
 using dlslot::backend::test::scanBox;
 
 namespace {
-
-const Eigen::Vector3d kSensor(0, 0, 1.73);
-const Eigen::Vector3d kCar(4.5, 1.8, 1.5);
 
 // The largest error of the centre along a horizontal direction the result says it measured (to
 // better than 3 cm): a car seen from behind measures its motion along, not across, the line of sight.

@@ -11,6 +11,10 @@
 
 namespace dlslot::backend::test {
 
+// The lidar above the ground and a typical car (l, w, h) for the scenes of these tests.
+inline const Eigen::Vector3d kSensor(0, 0, 1.73);
+inline const Eigen::Vector3d kCar(4.5, 1.8, 1.5);
+
 // The first hit of the ray from `origin` along `dir` with the box (its own frame: centred,
 // half sizes `half`), if any.
 inline bool rayBox(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, const Eigen::Vector3d& half, double* hit) {

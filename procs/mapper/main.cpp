@@ -202,31 +202,32 @@ int runLive(const MapperConfig& config, const Channels& channels, const NodeOpti
         node.status().warn("LIDAR_SCAN of frame " + std::to_string(frame) + " arrived after the frame was released");
     }
   };
+  auto handleJoined = [&](Joiner::Joined& j) {
+    if (!j.a) node.status().timeout("LIDAR_SCAN of frame " + std::to_string(j.frame));
+    if (!j.b) node.status().timeout("SLOT_STATE of frame " + std::to_string(j.frame));
+    if (!j.a || !j.b) return;
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      const Pose slot_pose = j.b->pose;
+      const int64_t utime = j.b->utime;
+      feed(mapper, j);
+      reportWorkers(mapper, node.status(), channels.scan);
+      node.publish(channels.map_state, mapStateMsg(mapper, j.frame, utime, slot_pose, mapper.loops().takeEvents()));
+      node.status().frameDone(j.frame, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+      const MapperSnapshot now = mapper.snapshot();
+      node.status().set("keyframes", now.keyframes);
+      node.status().set("map_voxels", static_cast<int64_t>(now.map_voxels));
+      node.status().set("keyframes_waiting", static_cast<int64_t>(now.backlog));
+      node.status().set("keyframes_deferred", now.keyframes_deferred);
+      node.status().set("loops_accepted", mapper.loops().accepted());
+      node.status().set("loops_refused", mapper.loops().rejected());
+    } catch (const std::exception& e) {
+      node.status().error(std::string("frame ") + std::to_string(j.frame) + ": " + e.what());
+    }
+  };
   auto handleReady = [&] {
     takeOpened();
-    for (Joiner::Joined& j : joiner.release(nowSeconds())) {
-      if (!j.a) node.status().timeout("LIDAR_SCAN of frame " + std::to_string(j.frame));
-      if (!j.b) node.status().timeout("SLOT_STATE of frame " + std::to_string(j.frame));
-      if (!j.a || !j.b) continue;
-      const auto start = std::chrono::steady_clock::now();
-      try {
-        const Pose slot_pose = j.b->pose;
-        const int64_t utime = j.b->utime;
-        feed(mapper, j);
-        reportWorkers(mapper, node.status(), channels.scan);
-        node.publish(channels.map_state, mapStateMsg(mapper, j.frame, utime, slot_pose, mapper.loops().takeEvents()));
-        node.status().frameDone(j.frame, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-        const MapperSnapshot now = mapper.snapshot();
-        node.status().set("keyframes", now.keyframes);
-        node.status().set("map_voxels", static_cast<int64_t>(now.map_voxels));
-        node.status().set("keyframes_waiting", static_cast<int64_t>(now.backlog));
-        node.status().set("keyframes_deferred", now.keyframes_deferred);
-        node.status().set("loops_accepted", mapper.loops().accepted());
-        node.status().set("loops_refused", mapper.loops().rejected());
-      } catch (const std::exception& e) {
-        node.status().error(std::string("frame ") + std::to_string(j.frame) + ": " + e.what());
-      }
-    }
+    for (Joiner::Joined& j : joiner.release(nowSeconds())) handleJoined(j);
   };
   // The scans sealed, to the opener (their points are decoded for keyframes only). A restart
   // forgets the frame order only after the scans that came before it are through.
@@ -263,10 +264,13 @@ int runLive(const MapperConfig& config, const Channels& channels, const NodeOpti
                 opener.catchUps());
   }
   // Stopped (SIGINT/SIGTERM): what is still waiting goes in, then the files.
+  // A scan can still be with the opener when the run stops (at idle priority it waits while the
+  // cores are busy elsewhere): opened now at normal priority, its frame handled and counted like any
+  // other, and the status published again so the launcher's accounting sees it.
   opener.wait(/*lift=*/true);
   takeOpened();
-  for (Joiner::Joined& j : joiner.flush())
-    if (j.a && j.b) feed(mapper, j);
+  for (Joiner::Joined& j : joiner.flush()) handleJoined(j);
+  node.publishStatus();
   mapper.finish();
   reportWorkers(mapper, node.status(), channels.scan);
   const std::vector<std::string> files = out.empty() ? std::vector<std::string>{} : writeMapOutputs(out, mapper);

@@ -14,6 +14,7 @@
 #include <pcl/registration/gicp.h>
 #pragma GCC diagnostic pop
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -56,6 +57,7 @@ void score(const PointCloud& query, const pcl::KdTreeFLANN<pcl::PointXYZ>& tree,
       sq += d2[0];
     }
   }
+  r.inliers = inliers;
   r.inlier_ratio = supported ? double(inliers) / supported : 0.0;
   r.support_ratio = structure ? double(supported) / structure : 0.0;
   r.rmse_m = inliers ? std::sqrt(sq / inliers) : 0.0;
@@ -175,6 +177,24 @@ LoopVerdict verifyLoop(const PointCloud& query, const PointCloud& match, const P
       v.reason = why.str();
       return v;
     }
+  }
+  // Localisation: the accepted pose moved false_loop_m (the error that makes a loop false) along the
+  // match keyframe's x or y must lose inliers; keeping ambiguity_ratio of them or more, it is as good
+  // as the pose, and the place cannot tell a false loop from a right one (a straight road between
+  // guard rails: the rails align at any shift along them).
+  for (const Eigen::Vector3d& shift : {Eigen::Vector3d(c.false_loop_m, 0, 0), Eigen::Vector3d(-c.false_loop_m, 0, 0),
+                                      Eigen::Vector3d(0, c.false_loop_m, 0), Eigen::Vector3d(0, -c.false_loop_m, 0)}) {
+    Registration moved;
+    score(query, tree, Eigen::Translation3d(shift) * best.T_match_query, c.inlier_distance_m, c.support_distance_m,
+          c.overlap_radius_m, moved);
+    v.shifted_inlier_share = std::max(v.shifted_inlier_share, best.inliers ? double(moved.inliers) / best.inliers : 1.0);
+  }
+  if (v.shifted_inlier_share >= c.ambiguity_ratio) {
+    why.precision(3);
+    why << "not localised: moved " << c.false_loop_m << " m along the road it keeps " << v.shifted_inlier_share
+        << " of its inliers (max " << c.ambiguity_ratio << ")";
+    v.reason = why.str();
+    return v;
   }
   v.accepted = true;
   return v;

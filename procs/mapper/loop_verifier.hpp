@@ -16,6 +16,12 @@
 //      the same pose, or end clearly worse. Guard rails with posts, rows of parked cars and
 //      corridors align equally well at several shifts; such a place cannot tell where along
 //      it the vehicle is, so it is refused.
+//   4. localisation: the accepted pose moved false_loop_m (1 m, the error that makes a loop false)
+//      along the match keyframe's x or y must lose inliers (keep fewer than ambiguity_ratio of them).
+//      A place whose structure is nearly all along the road (rails, kerbs, a long wall) aligns
+//      as well 1 m further on; test 3 finds no other pose there (one broad minimum, not two), but
+//      the registration's error along the road can reach a metre (a highway under forced
+//      candidates: accepted edges 1.05-1.07 m off).
 #pragma once
 
 #include <string>
@@ -35,6 +41,7 @@ struct Registration {
   // ... and of those, the share within inlier_distance of the match.
   double inlier_ratio = 0;
   double rmse_m = 0;        // RMS distance of those inliers
+  int inliers = 0;          // their number
 };
 
 struct RegistrationStart {
@@ -48,6 +55,7 @@ struct LoopVerdict {
   Registration registration;                         // the kept result (tests 1-3 judge it)
   Eigen::Vector3d start_shift = Eigen::Vector3d::Zero();  // the start it came from
   std::vector<RegistrationStart> starts;             // every start's result, the direct one first
+  double shifted_inlier_share = 0;  // test 4: the most inliers kept with the pose moved false_loop_m (0: not reached)
 };
 
 // Clouds: x y z columns in each keyframe's lidar frame (intensity unused).

@@ -154,14 +154,15 @@ std::vector<std::string> writeMapOutputs(const std::string& dir, const Mapper& m
     std::ofstream lp(d / "map_loops.txt");
     lp.precision(9);
     lp << "# query_frame match_frame accepted descriptor_distance inlier_ratio rmse_m, T_match_query as 12 numbers "
-          "(3x4 row-major), then the reason it was refused\n";
+          "(3x4 row-major), "
+          "the share of its inliers kept when moved false_loop_m (0: not reached), then the reason it was refused\n";
     for (const LoopEvent& e : mapper.loops().allEvents()) {
       const Registration& r = e.verdict.registration;
       lp << e.query_frame << " " << e.match_frame << " " << (e.verdict.accepted ? 1 : 0) << " " << e.descriptor_distance
          << " " << r.inlier_ratio << " " << r.rmse_m;
       for (int i = 0; i < 3; ++i)
         for (int c = 0; c < 4; ++c) lp << " " << r.T_match_query.matrix()(i, c);
-      lp << " " << (e.verdict.accepted ? "-" : e.verdict.reason) << "\n";
+      lp << " " << e.verdict.shifted_inlier_share << " " << (e.verdict.accepted ? "-" : e.verdict.reason) << "\n";
     }
     if (!lp) throw std::runtime_error((d / "map_loops.txt").string() + ": cannot write");
   }

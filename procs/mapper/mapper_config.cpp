@@ -77,6 +77,7 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
   l.get("max_drift_fraction", L.max_drift_fraction);
   l.get("ambiguity_shift_m", L.ambiguity_shift_m);
   l.get("ambiguity_ratio", L.ambiguity_ratio);
+  l.get("false_loop_m", L.false_loop_m);
   l.get("start_step_m", L.start_step_m);
   l.get("start_steps", L.start_steps);
   l.get("quiet_keyframes", L.quiet_keyframes);
@@ -103,6 +104,7 @@ MapperConfig MapperConfig::read(ConfigSection& s) {
                              {"max_rmse_m", L.max_rmse_m},
                              {"ambiguity_shift_m", L.ambiguity_shift_m},
                              {"ambiguity_ratio", L.ambiguity_ratio},
+                             {"false_loop_m", L.false_loop_m},
                              {"start_step_m", L.start_step_m},
                              {"odometry_sigma_t", L.odometry_sigma_t},
                              {"odometry_sigma_r", L.odometry_sigma_r},

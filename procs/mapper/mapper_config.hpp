@@ -25,6 +25,7 @@ struct LoopConfig {
   double inlier_distance_m = 0.3, support_distance_m = 1.0, min_inlier_ratio = 0.5, max_rmse_m = 0.25;
   double max_drift_fraction = 0.03;
   double ambiguity_shift_m = 4.0, ambiguity_ratio = 0.9;
+  double false_loop_m = 1.0;  // an accepted loop farther than this from the truth is false (dlslot-eval's map.loops_false)
   // Registration starts besides the prior: shifted k x start_step_m along the query's x and y, k = 1..start_steps,
   // those within the drift bound.
   double start_step_m = 4.0;

@@ -216,7 +216,10 @@ void SlidingWindow::addObservations(const BackendInput& in, BackendOutput& out) 
     track.last_seen = in.frame;
     track.dynamic_guess = obs.dynamic_guess;
     track.confidence = obs.confidence;
-    track.observations[in.frame] = Observation{alignedBox(track, X, obs.box), false};
+    const Pose b = alignedBox(track, X, obs.box);
+    // alignedBox turned the box round when it pointed against the track: its vote on the front.
+    track.front = withDetection(track.front, obs.box.yaw, yawOf(b.linear()));
+    track.observations[in.frame] = Observation{b, false};
     registerPoints(track, obs, in.frame, X, out);
     // Not in O_init yet, or not confirmed by the tracker's lifecycle (a likely false positive):
     // evidence only, never in the graph where it could pull the ego poses.
@@ -528,12 +531,6 @@ void SlidingWindow::solve(BackendOutput& out) {
   out.stats.covariance_ms = msSince(t1);
 }
 
-namespace {
-// Faster than a vehicle reverses in traffic (walking pace, < 2 m/s), with a margin for the
-// velocity error of a young track (~1 m/s).
-constexpr double kSurelyForwardMps = 3.0;
-}  // namespace
-
 void SlidingWindow::fillTracks(BackendOutput& out) {
   const int t = frames_.back().frame;
   auto covariance = [&](const double* block) -> Matrix6 {
@@ -604,15 +601,13 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
       }
       if (track.velocity) e.velocity = *track.velocity;
       e.angular_velocity = track.angular_velocity;
-      // alignedBox keeps a track's heading consistent with itself, so a track born from a box
-      // turned round heads backwards for good. Vehicles in traffic reverse at walking pace at
-      // most: one moving faster than kSurelyForwardMps heads where it goes, and a track found
-      // heading the other way is published turned by pi (the same box; velocity and covariance
-      // are world-frame and unchanged). Decided anew whenever the speed says so, kept in between.
-      if (isVehicle(track.type) && track.velocity && track.velocity->head<2>().norm() > kSurelyForwardMps)
-        track.reversed = track.velocity->head<2>().dot(e.pose.linear().col(0).head<2>()) < 0;
-      if (track.reversed) e.pose.linear() = e.pose.linear() * Eigen::Vector3d(-1, -1, 1).asDiagonal();
+      if (track.velocity) track.front = withMotion(track.front, track.velocity->head<2>(), e.pose.linear().col(0).head<2>());
     }
+    // alignedBox keeps a track's heading consistent with itself, so a track born from a box turned
+    // round heads backwards: a vehicle whose front (its motion, else its detections' majority,
+    // track_front.hpp) is the other end is published turned by pi, the same box (velocity and
+    // covariance are world-frame and unchanged).
+    if (isVehicle(track.type) && turned(track.front)) e.pose.linear() = e.pose.linear() * Eigen::Vector3d(-1, -1, 1).asDiagonal();
     if (block) e.covariance = covariance(block);
     // The published box made to cover the object's accumulated points of this frame (a partly
     // seen car's size and centre); the graph keeps its own estimate.
@@ -747,7 +742,7 @@ Pose SlidingWindow::alignedBox(const Track& track, const Pose& X, const Box& box
     if (const EgoFrame* ego = findFrame(f)) reference = yawOf(fromBlock(ego->pose->data()).linear() * obs.b.linear());
   }
   Box b = box;
-  if (reference && std::abs(wrapAngle(yawOf(X.linear() * b.pose().linear()) - *reference)) > M_PI / 2)
+  if (reference && !headingsAgree(yawOf(X.linear() * b.pose().linear()), *reference))
     b.yaw = wrapAngle(b.yaw + M_PI);
   return b.pose();
 }

@@ -24,6 +24,7 @@
 #include "backend/motion_evidence.hpp"
 #include "backend/object_model.hpp"
 #include "backend/pose_manifold.hpp"
+#include "backend/track_front.hpp"
 #include "backend/window_solver.hpp"
 
 namespace dlslot::backend {
@@ -75,7 +76,7 @@ class SlidingWindow {
     // chain to estimate it again (coasting, or about to leave).
     std::optional<Eigen::Vector3d> velocity;
     bool velocity_from_chain = false;
-    bool reversed = false;  // its boxes' heading points backwards: published turned by pi (fillTracks)
+    TrackFront front;  // which end its boxes' heading points to (track_front.hpp)
     // Per-object registration: the object's accumulated points (its model, world frame of its
     // latest scan) and the same prepared as the next frame's source (the latest scan alone when
     // registration_model_frames is 1), and the motions measured between consecutive scans

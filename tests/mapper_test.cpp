@@ -69,13 +69,19 @@ void addPole(std::vector<Eigen::Vector3d>& w, double x, double y, double height 
     for (int a = 0; a < 8; ++a) w.emplace_back(x + 0.15 * std::cos(a * M_PI / 4), y + 0.15 * std::sin(a * M_PI / 4), z);
 }
 
-// A highway's shoulders: guard rails on both sides with a post every 4 m, nothing else.
-std::vector<Eigen::Vector3d> guardRailWorld() {
+// A straight road 200 m long between guard rails (their beams only), 7 m either side.
+std::vector<Eigen::Vector3d> railedRoad() {
   std::vector<Eigen::Vector3d> w;
   addGround(w, -100, 100, -8, 8);
   for (double x = -100; x <= 100; x += 0.1)
     for (double side : {-7.0, 7.0})
       for (double z = -1.0; z <= -0.6; z += 0.1) w.emplace_back(x, side, z);
+  return w;
+}
+
+// A highway's shoulders: guard rails on both sides with a post every 4 m, nothing else.
+std::vector<Eigen::Vector3d> guardRailWorld() {
+  std::vector<Eigen::Vector3d> w = railedRoad();
   for (double x = -100; x <= 100; x += 4.0)
     for (double side : {-7.2, 7.2}) addPole(w, x, side, 1.0);
   return w;
@@ -349,11 +355,7 @@ TEST(LoopVerifier, GuardRailsWithRegularPostsAreRefusedAsAmbiguous) {
 // the road (the error that makes a loop false) the rails still lie on the rails and 95 % of the
 // inliers stay: the pose rests on one beam, and a loop there is refused.
 TEST(LoopVerifier, GuardRailsUnderOneGantryAreRefusedAsNotLocalised) {
-  std::vector<Eigen::Vector3d> world;
-  addGround(world, -100, 100, -8, 8);
-  for (double x = -100; x <= 100; x += 0.1)
-    for (double side : {-7.0, 7.0})
-      for (double z = -1.0; z <= -0.6; z += 0.1) world.emplace_back(x, side, z);
+  std::vector<Eigen::Vector3d> world = railedRoad();
   for (double y = -7.0; y <= 7.0; y += 0.1)
     for (double z = 3.5; z <= 3.75; z += 0.1) world.emplace_back(9.0, y, z);
   const Pose Tm = poseXYYaw(0, 0, 0), Tq = poseXYYaw(1.0, 0.3, 0.0);

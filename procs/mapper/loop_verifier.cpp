@@ -191,7 +191,7 @@ LoopVerdict verifyLoop(const PointCloud& query, const PointCloud& match, const P
   }
   if (v.shifted_inlier_share >= c.ambiguity_ratio) {
     why.precision(3);
-    why << "not localised: moved " << c.false_loop_m << " m along the road it keeps " << v.shifted_inlier_share
+    why << "not localised: moved " << c.false_loop_m << " m along x or y it keeps " << v.shifted_inlier_share
         << " of its inliers (max " << c.ambiguity_ratio << ")";
     v.reason = why.str();
     return v;

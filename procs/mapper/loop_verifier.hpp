@@ -52,7 +52,7 @@ struct RegistrationStart {
 struct LoopVerdict {
   bool accepted = false;
   std::string reason;  // the failed test, "" when accepted
-  Registration registration;                         // the kept result (tests 1-3 judge it)
+  Registration registration;                         // the kept result (tests 1-4 judge it)
   Eigen::Vector3d start_shift = Eigen::Vector3d::Zero();  // the start it came from
   std::vector<RegistrationStart> starts;             // every start's result, the direct one first
   double shifted_inlier_share = 0;  // test 4: the most inliers kept with the pose moved false_loop_m (0: not reached)

@@ -154,8 +154,8 @@ std::vector<std::string> writeMapOutputs(const std::string& dir, const Mapper& m
     std::ofstream lp(d / "map_loops.txt");
     lp.precision(9);
     lp << "# query_frame match_frame accepted descriptor_distance inlier_ratio rmse_m, T_match_query as 12 numbers "
-          "(3x4 row-major), "
-          "the share of its inliers kept when moved false_loop_m (0: not reached), then the reason it was refused\n";
+          "(3x4 row-major), the share of its inliers kept when moved false_loop_m (0: not reached), then the reason "
+          "it was refused\n";
     for (const LoopEvent& e : mapper.loops().allEvents()) {
       const Registration& r = e.verdict.registration;
       lp << e.query_frame << " " << e.match_frame << " " << (e.verdict.accepted ? 1 : 0) << " " << e.descriptor_distance

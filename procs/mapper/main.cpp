@@ -3,11 +3,8 @@
 // offline from a recorded run (--offline RUN.lcmlog --out DIR).
 #include <lcm/lcm-cpp.hpp>
 #include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <chrono>
@@ -41,9 +38,6 @@ struct RawScan {
   size_t offset = 0, size = 0;  // the LCM-encoded scan within `bytes`
 };
 using Joiner = FrameJoiner<RawScan, MapperInput>;
-
-// The receiving thread's nice (with idle_priority), see runLive.
-constexpr int kReceiveNice = 5;
 
 // Scans that may wait for the opener before it catches up at normal priority: in lockstep one or
 // two are in flight; eight (~16 MB) absorb a few busy seconds at 10 frames/s.
@@ -187,14 +181,6 @@ int runOffline(const MapperConfig& config, const Channels& channels, const std::
 }
 
 int runLive(const MapperConfig& config, const Channels& channels, const NodeOptions& opts, const std::string& out) {
-  // The receiving thread (LCM, the 2 MB scans' copies, joining, MAP_STATE) yields to the pipeline
-  // too: at nice kReceiveNice it runs in the pipeline's idle gaps instead of pre-empting the odometry
-  // (lockstep, highway seed 1: the mapper's cost to the rate 1.6 % against 2.9 % at nice 0, six
-  // rounds, docs/mapping.md). Weight 335 against a busy pipeline thread's 1024 still leaves it
-  // about a quarter of a core, several times the ~1.2 ms a frame receiving takes at 30 frames/s; at
-  // nice 10 (weight 110) it fell behind and the kernel dropped datagrams (6 frames lost of 150).
-  if (config.idle_priority && setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), kReceiveNice) != 0)
-    std::fprintf(stderr, "mapper: could not lower the receiving thread's priority: %s\n", std::strerror(errno));
   Node node("mapper", opts.lcm_url, channels);
   Mapper mapper(config, /*threaded=*/true);
   for (const std::string& e : mapper.priorityErrors()) node.status().warn(e + " (it runs at normal priority)");

@@ -35,6 +35,7 @@
 #include "dlslot/receive_buffer.hpp"
 #include "dlslot/slot_state_t.hpp"
 #include "scan_folder.hpp"
+#include "end_wait.hpp"
 #include "supervisor.hpp"
 
 using namespace dlslot;
@@ -531,6 +532,17 @@ int runPipeline(int argc, char** argv) {
     for (const auto& p : pipeline)
       late = late || !heard.count(p) || std::chrono::duration<double>(Node::Clock::now() - heard[p]).count() > 2.5;
     if (!late) break;
+    failIfDead("player");
+    failIfSilent();
+    node.spinUntil([] { return false; }, 0.1);
+  }
+  // A process may still hold frames it has not taken yet (end_wait.hpp).
+  for (run::EndWait wait;;) {
+    const FrameAccounting a = accountFrames(health, last_frame + 1, accounted);
+    long long taken = 0;
+    for (const ProcessFrames& p : a.processes) taken += p.handled + p.skipped;
+    const double now_s = std::chrono::duration<double>(Node::Clock::now().time_since_epoch()).count();
+    if (!wait.waiting(now_s, a.lost(), taken)) break;
     failIfDead("player");
     failIfSilent();
     node.spinUntil([] { return false; }, 0.1);

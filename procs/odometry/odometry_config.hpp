@@ -126,6 +126,9 @@ struct OdometryConfig {
   // correspondences (searched within scan_to_map.max_neighbor_distance_m, 1 m) reach the right
   // surfaces and pull it back by itself. Half that radius.
   double check_min_disagreement_m = 0.5;
+  // How the scans were taken (the lidar section, not the odometry's): each scan's features are
+  // moved to its reference instant before registration (lidar_odometry.cpp). 0: de-skewed scans.
+  SweepTiming sweep{0.0, true};
 };
 
 // Parses a mode name: "aloam" (no removal) or "aloam-filtered" (A-LOAM*); throws

@@ -13,8 +13,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <array>
 #include <cmath>
+#include <vector>
 
 #include "dlslot/sweep_timing.hpp"
 #include "dlslot/types.hpp"
@@ -68,25 +68,43 @@ inline BodyTwist twistBetween(const Pose& from, const Pose& to, double dt) {
   return out;
 }
 
-// Moves each point (lidar frame of its firing, x y z in rows 0-2) into the lidar frame of the
-// reference instant: p_ref = T_ref_lidar(t(p)) p. The firing time is quantized to 1/1024 of the
-// sweep (98 microseconds of a 0.1 s sweep: 2 mm at 20 m/s), one transform per bin, so a scan of
-// 100k points costs 100k small matrix products. A period of 0 (de-skewed scans) leaves the points.
+// The motion of one sweep, for moving points (lidar frame of their firing) into the lidar frame
+// of the reference instant: p_ref = T_ref_lidar(t(p)) p. The firing time is quantized to 1/1024
+// of the sweep (98 microseconds of a 0.1 s sweep: 2 mm at 20 m/s), one transform per bin, so a
+// scan of 100k points costs 100k small matrix products. A period of 0 (de-skewed scans) leaves
+// the points where they are.
+class SweepMotion {
+ public:
+  SweepMotion(const SweepTiming& sweep, const BodyTwist& twist) : sweep_(sweep) {
+    if (sweep_.period_s <= 0) return;
+    R_.resize(kBins + 1);
+    t_.resize(kBins + 1);
+    for (int b = 0; b <= kBins; ++b) {
+      const Pose T = twist.at((static_cast<double>(b) / kBins - 0.5) * sweep_.period_s);
+      R_[b] = T.linear().cast<float>();
+      t_[b] = T.translation().cast<float>();
+    }
+  }
+
+  Eigen::Vector3f toReference(const Eigen::Vector3f& p) const {
+    if (R_.empty()) return p;
+    const double f = sweep_.firingTime(p.x(), p.y()) / sweep_.period_s + 0.5;  // [0, 1]
+    const int b = std::clamp(static_cast<int>(std::lround(f * kBins)), 0, kBins);
+    return R_[b] * p + t_[b];
+  }
+
+ private:
+  static constexpr int kBins = 1024;
+  SweepTiming sweep_;
+  std::vector<Eigen::Matrix3f> R_;
+  std::vector<Eigen::Vector3f> t_;
+};
+
+// Every point of `points` (x y z in rows 0-2) into the lidar frame of the reference instant.
 inline void deskew(PointCloud& points, const SweepTiming& sweep, const BodyTwist& twist) {
   if (sweep.period_s <= 0) return;
-  constexpr int kBins = 1024;
-  std::array<Eigen::Matrix3f, kBins + 1> R;
-  std::array<Eigen::Vector3f, kBins + 1> t;
-  for (int b = 0; b <= kBins; ++b) {
-    const Pose T = twist.at((static_cast<double>(b) / kBins - 0.5) * sweep.period_s);
-    R[b] = T.linear().cast<float>();
-    t[b] = T.translation().cast<float>();
-  }
-  for (Eigen::Index i = 0; i < points.cols(); ++i) {
-    const double f = sweep.firingTime(points(0, i), points(1, i)) / sweep.period_s + 0.5;  // [0, 1]
-    const int b = std::clamp(static_cast<int>(std::lround(f * kBins)), 0, kBins);
-    points.col(i).head<3>() = R[b] * points.col(i).head<3>() + t[b];
-  }
+  const SweepMotion motion(sweep, twist);
+  for (Eigen::Index i = 0; i < points.cols(); ++i) points.col(i).head<3>() = motion.toReference(points.col(i).head<3>());
 }
 
 }  // namespace dlslot

@@ -7,6 +7,7 @@
 
 #include <vector>
 
+#include "dlslot/frame_accounting.hpp"
 #include "dlslot/large_message_filter.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/receive_buffer.hpp"
@@ -115,3 +116,26 @@ TEST(LargeMessageFilter, LargeMessageOffTheScanChannelIsAnError) {
 }
 
 }  // namespace
+
+// A process that lags the pipeline by design (the mapper) holds four times the URL's buffer: 15
+// scans of 2 MB published while nobody reads (30 MB, more than the 16 MB every node holds) all
+// reach it; a node with the URL's buffer loses some to the kernel.
+TEST(ReceiveBuffer, ADeepenedBufferHoldsABacklogTheUsualOneDrops) {
+  lcm::LCM pub;
+  ASSERT_TRUE(pub.good());
+  Node usual("usual", ""), deep("deep", "");
+  deep.deepenReceiveBuffer(4);
+  const int64_t usual_bytes = statusCounter(usual.status().toMessage(), "recv_buffer_bytes");
+  const int64_t deep_bytes = statusCounter(deep.status().toMessage(), "recv_buffer_bytes");
+  ASSERT_GT(usual_bytes, 0) << "no recv_buf_size in $LCM_DEFAULT_URL";
+  EXPECT_GE(deep_bytes, 4 * usual_bytes);
+  Counts u, d;
+  countOn(usual, Channels().scan, &u);
+  countOn(deep, Channels().scan, &d);
+  const std::vector<uint8_t> scan(2000000, 7);
+  for (int i = 0; i < 15; ++i) pub.publish(Channels().scan, scan.data(), static_cast<unsigned>(scan.size()));
+  usual.spinUntil([] { return false; }, 0.5);
+  deep.spinUntil([] { return false; }, 0.5);
+  EXPECT_EQ(d.large, 15);
+  EXPECT_LT(u.large, 15);
+}

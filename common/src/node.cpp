@@ -304,7 +304,7 @@ bool signalReceived() { return g_signal; }
 // ---------------- Node ----------------
 
 Node::Node(std::string name, const std::string& lcm_url, const Channels& channels)
-    : name_(std::move(name)), lcm_(lcm_url), channels_(channels), status_(name_) {
+    : name_(std::move(name)), lcm_(lcm_url), channels_(channels), status_(name_), lcm_url_(lcm_url) {
   if (std::optional<RunKey> key = keyFromEnvironment()) {
     auth_ = MessageAuth(*key);
     std::fprintf(stderr, "[%s] messages authenticated with the run key %s (run %s)\n", name_.c_str(),
@@ -436,6 +436,15 @@ void Node::every(double period_s, std::function<void()> cb) {
 void Node::after(double delay_s, std::function<void()> cb) {
   timers_.push_back({Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(delay_s)),
                      0.0, std::move(cb)});
+}
+
+void Node::deepenReceiveBuffer(int factor) {
+  const char* env = std::getenv("LCM_DEFAULT_URL");
+  const int64_t want = requestedReceiveBuffer(!lcm_url_.empty() ? lcm_url_ : env ? env : "");
+  if (recv_fd_ < 0 || want <= 0) return;
+  const ReceiveBuffer rb = enlargeReceiveBuffer(recv_fd_, want * factor);
+  status_.set("recv_buffer_bytes", rb.granted);
+  std::fprintf(stderr, "[%s] %s\n", name_.c_str(), rb.note.c_str());
 }
 
 void Node::publishStatus() {

@@ -178,6 +178,9 @@ class Node {
   bool spinUntil(const std::function<bool()>& pred, double timeout_s);
   void stop() { stop_ = true; }
   void publishStatus();
+  // A deeper receive buffer than the URL's (recv_buf_size x `factor`), for a process that may lag
+  // behind the pipeline by design; logged and reported as recv_buffer_bytes. Nothing without one.
+  void deepenReceiveBuffer(int factor);
 
  private:
   void handleOnce(double max_wait_s);
@@ -199,6 +202,7 @@ class Node {
   std::vector<Timer> timers_;
   std::map<std::string, FrameOrder> frame_order_;
   std::set<int> frames_received_;  // distinct frames that any frame channel carried
+  std::string lcm_url_;            // as given (empty: $LCM_DEFAULT_URL)
   int recv_fd_ = -1;               // LCM's receive socket, for its kernel drop count
   void handleRunEvent(const run_event_t& e);
   MessageAuth auth_;

@@ -124,7 +124,7 @@ TEST(ReceiveBuffer, ADeepenedBufferHoldsABacklogTheUsualOneDrops) {
   lcm::LCM pub;
   ASSERT_TRUE(pub.good());
   Node usual("usual", ""), deep("deep", "");
-  deep.deepenReceiveBuffer(4);
+  deep.setReceiveBuffer(4);
   const int64_t usual_bytes = statusCounter(usual.status().toMessage(), "recv_buffer_bytes");
   const int64_t deep_bytes = statusCounter(deep.status().toMessage(), "recv_buffer_bytes");
   ASSERT_GT(usual_bytes, 0) << "no recv_buf_size in $LCM_DEFAULT_URL";

@@ -304,7 +304,7 @@ bool signalReceived() { return g_signal; }
 // ---------------- Node ----------------
 
 Node::Node(std::string name, const std::string& lcm_url, const Channels& channels)
-    : name_(std::move(name)), lcm_(lcm_url), channels_(channels), status_(name_), lcm_url_(lcm_url) {
+    : name_(std::move(name)), lcm_(lcm_url), channels_(channels), status_(name_) {
   if (std::optional<RunKey> key = keyFromEnvironment()) {
     auth_ = MessageAuth(*key);
     std::fprintf(stderr, "[%s] messages authenticated with the run key %s (run %s)\n", name_.c_str(),
@@ -328,12 +328,9 @@ Node::Node(std::string name, const std::string& lcm_url, const Channels& channel
     for (const int fd : udpSocketsOnPort(port))
       if (std::find(before.begin(), before.end(), fd) == before.end()) recv_fd_ = fd;
   }
+  url_buffer_bytes_ = requestedReceiveBuffer(url);
   if (recv_fd_ >= 0) {
-    if (const int64_t want = requestedReceiveBuffer(url); want > 0) {
-      const ReceiveBuffer rb = enlargeReceiveBuffer(recv_fd_, want);
-      status_.set("recv_buffer_bytes", rb.granted);
-      std::fprintf(stderr, "[%s] %s\n", name_.c_str(), rb.note.c_str());
-    }
+    setReceiveBuffer(1);
     // No subscription yet, so no point cloud is wanted until one subscribes to the scan channel.
     filtering_large_ = attachLargeMessageFilter(recv_fd_);
   }
@@ -438,11 +435,9 @@ void Node::after(double delay_s, std::function<void()> cb) {
                      0.0, std::move(cb)});
 }
 
-void Node::deepenReceiveBuffer(int factor) {
-  const char* env = std::getenv("LCM_DEFAULT_URL");
-  const int64_t want = requestedReceiveBuffer(!lcm_url_.empty() ? lcm_url_ : env ? env : "");
-  if (recv_fd_ < 0 || want <= 0) return;
-  const ReceiveBuffer rb = enlargeReceiveBuffer(recv_fd_, want * factor);
+void Node::setReceiveBuffer(int times_url) {
+  if (recv_fd_ < 0 || url_buffer_bytes_ <= 0) return;
+  const ReceiveBuffer rb = enlargeReceiveBuffer(recv_fd_, url_buffer_bytes_ * times_url);
   status_.set("recv_buffer_bytes", rb.granted);
   std::fprintf(stderr, "[%s] %s\n", name_.c_str(), rb.note.c_str());
 }

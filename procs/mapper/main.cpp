@@ -185,7 +185,7 @@ int runLive(const MapperConfig& config, const Channels& channels, const NodeOpti
   // The mapper takes every scan off the pipeline's critical path and may lag it by design; with the
   // renderer on, in 3 of 39 runs (highway seed 1, 150 frames, lockstep, quiet machine) it fell more than
   // the pipeline's 7 scans behind and the kernel dropped datagrams. Four times the depth: ~30 scans.
-  node.deepenReceiveBuffer(4);
+  node.setReceiveBuffer(4);
   Mapper mapper(config, /*threaded=*/true);
   for (const std::string& e : mapper.priorityErrors()) node.status().warn(e + " (it runs at normal priority)");
   Joiner joiner(config.join_timeout_s);

@@ -15,7 +15,11 @@ class EndWait {
   // `taken`: frames handled or skipped, summed over the processes. True: wait and ask again.
   bool waiting(double now_s, long long missing, long long taken) {
     if (missing <= 0) return false;
-    if (!started_ || taken != taken_) started_ = true, taken_ = taken, since_s_ = now_s;
+    if (!started_ || taken != taken_) {  // progress: the patience starts again
+      started_ = true;
+      taken_ = taken;
+      since_s_ = now_s;
+    }
     return now_s - since_s_ < patience_s_;
   }
 

@@ -178,9 +178,10 @@ class Node {
   bool spinUntil(const std::function<bool()>& pred, double timeout_s);
   void stop() { stop_ = true; }
   void publishStatus();
-  // A deeper receive buffer than the URL's (recv_buf_size x `factor`), for a process that may lag
-  // behind the pipeline by design; logged and reported as recv_buffer_bytes. Nothing without one.
-  void deepenReceiveBuffer(int factor);
+  // The receive buffer: `times_url` x the URL's recv_buf_size (the constructor asks for 1x; a
+  // process that lags the pipeline by design asks for more); logged and reported as
+  // recv_buffer_bytes. Nothing when the URL asks for none.
+  void setReceiveBuffer(int times_url);
 
  private:
   void handleOnce(double max_wait_s);
@@ -202,7 +203,7 @@ class Node {
   std::vector<Timer> timers_;
   std::map<std::string, FrameOrder> frame_order_;
   std::set<int> frames_received_;  // distinct frames that any frame channel carried
-  std::string lcm_url_;            // as given (empty: $LCM_DEFAULT_URL)
+  int64_t url_buffer_bytes_ = 0;   // the URL's recv_buf_size (0: none asked)
   int recv_fd_ = -1;               // LCM's receive socket, for its kernel drop count
   void handleRunEvent(const run_event_t& e);
   MessageAuth auth_;

@@ -120,6 +120,39 @@ TEST(SimWorld, NoSolidsOverlapAndMotionIsSmooth) {
   }
 }
 
+TEST(SimWorld, TheKittiRideRocksLikeKittisPosesAndRestsWhenStopped) {
+  // KITTI's GPS/INS poses (tracking train 0000-0009, scripts/body-ride.py): the pitch-and-roll
+  // change from frame to frame is 0.08-0.21 deg rms above 2 m/s and 0.007 standing. The ride set
+  // from them (0.1 deg, full from 2 m/s) must fall in that range while driving, vanish at rest and
+  // grow in proportion between; the default ride (0.5 deg at every speed) is 5x harder.
+  sim::EgoSpec kitti;
+  kitti.body_pitch_roll = 0.1 * M_PI / 180.0;
+  kitti.ride_full_speed_mps = 2.0;
+  auto rmsChangeDeg = [](const sim::BodyRide& ride, double speed) {
+    double sum = 0;
+    const int n = 10000;
+    for (int f = 1; f <= n; ++f) {
+      const Eigen::Matrix3d R = ride.at(0.1 * (f - 1), speed).linear().transpose() * ride.at(0.1 * f, speed).linear();
+      const double roll = std::atan2(R(2, 1), R(2, 2)), pitch = std::asin(-R(2, 0));
+      sum += roll * roll + pitch * pitch;
+    }
+    return std::sqrt(sum / n) * 180.0 / M_PI;
+  };
+  const sim::BodyRide ride(kitti, 7), old_ride(sim::EgoSpec(), 7);
+  const double driving = rmsChangeDeg(ride, 10.0), crawling = rmsChangeDeg(ride, 1.0), resting = rmsChangeDeg(ride, 0.0);
+  const double old_driving = rmsChangeDeg(old_ride, 10.0), old_resting = rmsChangeDeg(old_ride, 0.0);
+  std::printf("pitch-and-roll change a frame: KITTI ride %.3f deg at 10 m/s, %.3f at 1 m/s, %.4f at rest; default %.3f / %.3f\n",
+              driving, crawling, resting, old_driving, old_resting);
+  EXPECT_GT(driving, 0.08);
+  EXPECT_LT(driving, 0.21);
+  EXPECT_NEAR(crawling, 0.5 * driving, 1e-5);  // small angles: the composition is nearly linear
+  EXPECT_EQ(resting, 0.0);
+  EXPECT_TRUE(ride.at(3.0, 0.0).isApprox(Pose::Identity()));
+  EXPECT_NEAR(ride.at(3.0, 25.0).translation().z(), ride.at(3.0, 2.0).translation().z(), 1e-12);  // full from 2 m/s
+  EXPECT_NEAR(old_resting, old_driving, 1e-12);  // the default: the same ride at every speed
+  EXPECT_GT(old_driving, 4 * driving);
+}
+
 TEST(SimWorld, HighwaySurroundsTheEgoWithCarsAtItsSpeed) {
   const sim::Scenario sc = sim::test::shippedScenario("highway", 100);
   const sim::World world = sim::buildWorld(sc);

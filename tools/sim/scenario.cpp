@@ -297,6 +297,8 @@ Scenario loadScenario(const std::string& path) {
     }
     e.optional("body_heave_m", sc.ego.body_heave_m);
     if (!(sc.ego.body_heave_m >= 0)) e.fail("body_heave_m", "expected a number >= 0");
+    e.optional("ride_full_speed_mps", sc.ego.ride_full_speed_mps);
+    if (!(sc.ego.ride_full_speed_mps >= 0)) e.fail("ride_full_speed_mps", "expected a number >= 0 (0: the same ride at every speed)");
     sc.ego.speed_profile = e.pairs("speed_mps");
     for (size_t i = 1; i < sc.ego.speed_profile.size(); ++i)
       if (sc.ego.speed_profile[i].first <= sc.ego.speed_profile[i - 1].first)

@@ -89,7 +89,7 @@ Pose egoPose(const Eigen::Vector2d& xy, double heading, const Ground& ground, do
 
 }  // namespace
 
-BodyRide::BodyRide(const EgoSpec& ego, uint64_t key) {
+BodyRide::BodyRide(const EgoSpec& ego, uint64_t key) : full_speed_mps_(ego.ride_full_speed_mps) {
   Rng rng(key);
   // Three sinusoids of equal amplitude have an rms of amplitude * sqrt(3/2).
   const double scale[3] = {ego.body_pitch_roll, ego.body_pitch_roll, ego.body_heave_m};
@@ -107,12 +107,13 @@ double BodyRide::value(int axis, double t) const {
   return v;
 }
 
-Pose BodyRide::at(double t) const {
+Pose BodyRide::at(double t, double speed) const {
+  const double excitation = full_speed_mps_ > 0 ? std::clamp(speed / full_speed_mps_, 0.0, 1.0) : 1.0;
   Pose T = Pose::Identity();
-  T.linear() = (Eigen::AngleAxisd(value(1, t), Eigen::Vector3d::UnitX()) *
-                Eigen::AngleAxisd(value(0, t), Eigen::Vector3d::UnitY()))
+  T.linear() = (Eigen::AngleAxisd(excitation * value(1, t), Eigen::Vector3d::UnitX()) *
+                Eigen::AngleAxisd(excitation * value(0, t), Eigen::Vector3d::UnitY()))
                    .toRotationMatrix();
-  T.translation().z() = value(2, t);
+  T.translation().z() = excitation * value(2, t);
   return T;
 }
 
@@ -292,7 +293,7 @@ Motion simulateMotion(const Scenario& sc, const World& world) {
   const BodyRide ride(sc.ego, streamKey({sc.seed, 10}));
   for (int f = 0; f < sc.frames; ++f) {
     const Path::Sample at = movers[0].path->at(tr.s[0][f]);
-    out.ego.push_back(egoPose(at.p, at.heading, ground, sc.sensor.height_m) * ride.at(f * sc.frame_period_s));
+    out.ego.push_back(egoPose(at.p, at.heading, ground, sc.sensor.height_m) * ride.at(f * sc.frame_period_s, tr.v[0][f]));
   }
   for (size_t i = 1; i < movers.size(); ++i) {
     if (!alive[i]) continue;

@@ -37,17 +37,20 @@ struct Motion {
 };
 
 // The ego body's pitch, roll and heave on its suspension (EgoSpec), as a pose in the lidar frame
-// of the road-following pose: T_map_lidar = T_road * at(t).
+// of the road-following pose: T_map_lidar = T_road * at(t, speed).
 class BodyRide {
  public:
   BodyRide(const EgoSpec& ego, uint64_t key);
-  Pose at(double t) const;
+  // The ride at time t while the vehicle drives at `speed` m/s: the waves scaled by
+  // min(1, speed / EgoSpec::ride_full_speed_mps) when that is set (a vehicle at rest does not rock).
+  Pose at(double t, double speed) const;
   double value(int axis, double t) const;  // axis 0 pitch (rad), 1 roll (rad), 2 heave (m)
 
  private:
   struct Wave {
     double amplitude = 0, hz = 0, phase = 0;
   };
+  double full_speed_mps_ = 0;
   std::array<std::array<Wave, 3>, 3> waves_{};
 };
 

@@ -52,8 +52,8 @@ TEST(RunSupervisor, StoppedChildIsNotReported) {
   fs::remove(logPath("sleeper"));
 }
 
-// The CPU time a child used is known once it has exited: a busy child (copying 10 GB through dd: 0.04 s of CPU for 2 GB on a fast machine)
-// used far more than one that slept as long.
+// The CPU time a child used is known once it has exited: a busy child (copying 10 GB through dd;
+// a fast machine copies 2 GB in 0.04 s of CPU) used far more than one that slept as long.
 TEST(RunSupervisor, CpuTimeOfExitedChildren) {
   Supervisor sup;
   sup.start("busy", {"/bin/dd", "if=/dev/zero", "of=/dev/null", "bs=1M", "count=10000"}, logPath("busy"));

@@ -594,7 +594,7 @@ TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
   // A sigma list of the wrong length or with a non-positive entry.
   for (const char* bad : {"[0.005, 0.005]", "[0.005, 0.0, 0.005]"}) expectRefused("constant_acceleration_sigma", bad);
   // The odometry covariance scale: two factors, translation and rotation.
-  EXPECT_EQ(c.odometry_covariance_scale, Eigen::Vector2d(5.0, 20.0));
+  EXPECT_EQ(c.odometry_covariance_scale, Eigen::Vector2d(5.0, 5.0));
   for (const char* bad : {"20", "[5, 20, 1]", "[5, 0]"}) expectRefused("odometry_covariance_scale", bad);
   // The odometry factor's consistency test: a probability strictly inside (0, 1), a support >= 1.
   EXPECT_TRUE(c.odometry_check.enabled);

@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "odometry/local_map.hpp"
+#include "odometry/scan_to_map.hpp"
 #include "odometry_random_cloud.hpp"
 
 namespace dlslot::odometry {
@@ -151,6 +152,30 @@ TEST(OdometryDownsample, EqualsPclVoxelGrid) {
     }
   }
   EXPECT_TRUE(downsample(FeatureCloud(), 0.4).empty());
+}
+
+// Only near-vertical lines are matched as edges (scan_to_map.edge_max_tilt_deg): a ring crosses a
+// horizontal corner (a wall's foot, a kerb) where its cone meets it, which moves with the viewpoint.
+TEST(OdometryScanToMap, HorizontalLinesAreNotMatchedAsEdgesBeyondTheTiltLimit) {
+  FeatureCloud pole, foot;
+  for (int i = 0; i < 40; ++i) {
+    pole.push_back(pcl::PointXYZI(5.0f, 2.0f, -1.5f + 0.1f * i, 0.0f));  // vertical
+    foot.push_back(pcl::PointXYZI(-8.0f + 0.1f * i, -4.0f, -1.7f, 0.0f));  // horizontal, along x
+  }
+  FeatureCloud both = pole;
+  both += foot;
+  ScanToMapConfig cfg;
+  FeatureCloud queries;
+  queries.push_back(pcl::PointXYZI(5.05f, 2.0f, 0.0f, 0.0f));
+  queries.push_back(pcl::PointXYZI(-6.0f, -4.05f, -1.7f, 0.0f));
+  cfg.max_neighbor_distance_m = 2.0;  // five 0.4 m voxel means of a line within reach
+  LocalMap map(cfg);
+  map.insert(both, FeatureCloud(), Pose::Identity());
+  EXPECT_EQ(matchScanToMap(queries, FeatureCloud(), map, Pose::Identity(), cfg).edges.size(), 2u);  // A-LOAM: 90 deg
+  cfg.edge_max_tilt_deg = 45.0;
+  const Matches m = matchScanToMap(queries, FeatureCloud(), map, Pose::Identity(), cfg);
+  ASSERT_EQ(m.edges.size(), 1u);
+  EXPECT_NEAR(std::abs(m.edges[0].u.z()), 1.0, 1e-6);
 }
 
 }  // namespace

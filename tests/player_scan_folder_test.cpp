@@ -62,6 +62,10 @@ TEST(SensorCalibration, ReadsExtrinsicsBeamsAndRanges) {
   // Yaw 90 deg: the sensor's x axis is the vehicle's y axis.
   EXPECT_TRUE((c.T_vehicle_sensor.linear() * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY(), 1e-12));
   EXPECT_EQ(c.camera_calib, (fs::path(dir) / "cam/0000.txt").lexically_normal().string());
+  // A sensor stores its points on their rays unless its calibration says how far below (KITTI's 0.22 deg).
+  EXPECT_EQ(c.vertical_angle_error_deg, 0.0);
+  write(dir + "/kitti.yaml", std::string(kCalib) + "vertical_angle_error_deg: 0.22\n");
+  EXPECT_DOUBLE_EQ(player::readSensorCalibration(dir + "/kitti.yaml").vertical_angle_error_deg, 0.22);
 }
 
 TEST(SensorCalibration, BadFilesAreErrorsNamingTheFileAndTheKey) {
@@ -76,6 +80,9 @@ TEST(SensorCalibration, BadFilesAreErrorsNamingTheFileAndTheKey) {
   write(dir + "/c.yaml", std::string(kCalib) + "colour: red\n");
   e = errorOf([&] { player::readSensorCalibration(dir + "/c.yaml"); });
   EXPECT_NE(e.find("colour"), std::string::npos) << e;  // an unknown key is an error, not ignored
+  write(dir + "/d.yaml", std::string(kCalib) + "vertical_angle_error_deg: 22\n");  // degrees, not hundredths
+  e = errorOf([&] { player::readSensorCalibration(dir + "/d.yaml"); });
+  EXPECT_NE(e.find("vertical_angle_error_deg"), std::string::npos) << e;
   e = errorOf([&] { player::readSensorCalibration(dir + "/missing.yaml"); });
   EXPECT_NE(e.find("missing.yaml"), std::string::npos) << e;
 }

@@ -1,5 +1,9 @@
 #include "feature_deskew.hpp"
 
+#include <cmath>
+
+#include "dlslot/vertical_angle.hpp"
+
 namespace dlslot::odometry {
 
 BodyTwist vehicleTwist(const Pose& per_frame, double period_s) {
@@ -14,6 +18,13 @@ void deskewFeatures(ScanFeatures& features, const SweepTiming& sweep, const Body
   const SweepMotion motion(sweep, twist);
   for (FeatureCloud* cloud : {&features.sharp, &features.less_sharp, &features.flat, &features.less_flat})
     for (pcl::PointXYZI& p : cloud->points) p.getVector3fMap() = motion.toReference(p.getVector3fMap());
+}
+
+void correctElevation(ScanFeatures& features, double angle_rad) {
+  if (angle_rad == 0) return;
+  const float c = static_cast<float>(std::cos(angle_rad)), s = static_cast<float>(std::sin(angle_rad));
+  for (FeatureCloud* cloud : {&features.sharp, &features.less_sharp, &features.flat, &features.less_flat})
+    for (pcl::PointXYZI& p : cloud->points) raiseElevation(p.x, p.y, p.z, c, s);
 }
 
 }  // namespace dlslot::odometry

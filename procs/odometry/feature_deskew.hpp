@@ -1,4 +1,5 @@
-// A scan's features moved to its reference instant before registration. A spinning lidar fires
+// A scan's features put back on their rays (correctElevation) and moved to its reference instant
+// (deskewFeatures) before registration. A spinning lidar fires
 // its columns over one sweep while the vehicle moves (1 m of a 0.1 s sweep at 10 m/s), so a raw
 // scan is sheared; the features of each scan are de-skewed with the vehicle's motion of the
 // previous frame, as KISS-ICP does with its constant-velocity model.
@@ -20,5 +21,9 @@ BodyTwist vehicleTwist(const Pose& per_frame, double period_s);
 
 // Every point of the four feature clouds into the lidar frame of the scan's reference instant.
 void deskewFeatures(ScanFeatures& features, const SweepTiming& sweep, const BodyTwist& twist);
+
+// Every point of the four feature clouds put back on its ray: its elevation raised by
+// `angle_rad`, the lidar's vertical-angle error (dlslot/vertical_angle.hpp); 0 leaves them.
+void correctElevation(ScanFeatures& features, double angle_rad);
 
 }  // namespace dlslot::odometry

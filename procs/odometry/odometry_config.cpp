@@ -76,6 +76,7 @@ void readScanToMap(ConfigSection s, ScanToMapConfig& c) {
   s.get("neighbors", c.neighbors);
   s.get("max_neighbor_distance_m", c.max_neighbor_distance_m);
   s.get("edge_eigen_ratio", c.edge_eigen_ratio);
+  s.get("edge_max_tilt_deg", c.edge_max_tilt_deg);
   s.get("plane_max_deviation_m", c.plane_max_deviation_m);
   s.get("map_radius_m", c.map_radius_m);
   s.get("min_correspondences", c.min_correspondences);

@@ -38,6 +38,7 @@ Matches matchScanToMap(const FeatureCloud& edges, const FeatureCloud& planes, co
   Eigen::Vector3d mean;
   Eigen::Matrix3d scatter;
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  const double min_vertical = std::cos(cfg.edge_max_tilt_deg * M_PI / 180.0) - 1e-12;
 
   // An edge point matches the line through its neighbours when they are spread along one
   // direction (largest covariance eigenvalue dominates the second).
@@ -46,6 +47,7 @@ Matches matchScanToMap(const FeatureCloud& edges, const FeatureCloud& planes, co
     if (!fitNeighbours(map.edges(), T * p, cfg.neighbors, found, mean, scatter)) continue;
     eig.computeDirect(scatter);
     if (eig.eigenvalues()[2] <= cfg.edge_eigen_ratio * eig.eigenvalues()[1]) continue;
+    if (std::abs(eig.eigenvectors().col(2).z()) < min_vertical) continue;
     m.edges.push_back({p.cast<double>(), mean, eig.eigenvectors().col(2)});
   }
 

@@ -91,6 +91,10 @@ SensorCalibration readSensorCalibration(const std::string& path) {
     c.min_range_m = range[0], c.max_range_m = range[1];
     if (!(range[0] >= 0 && range[1] > range[0]))
       throw InputError(path, 0, "range_m: expected [min, max] with 0 <= min < max");
+    if (s.has("vertical_angle_error_deg")) s.get("vertical_angle_error_deg", c.vertical_angle_error_deg);
+    if (!(std::abs(c.vertical_angle_error_deg) <= 5.0))
+      throw InputError(path, 0, "vertical_angle_error_deg: expected a value in [-5, 5] deg, got " +
+                                    std::to_string(c.vertical_angle_error_deg));
     if (s.has("camera_calib")) {
       s.get("camera_calib", c.camera_calib);
       fs::path p(c.camera_calib);

@@ -35,6 +35,7 @@ struct SensorCalibration {
   int beams = 0;                        // uniform: count, top and bottom elevations
   double top_elevation_deg = 0, bottom_elevation_deg = 0;
   double min_range_m = 0, max_range_m = 1e9;
+  double vertical_angle_error_deg = 0;  // how far below its ray the sensor stores each point
   std::string camera_calib;             // absolute, or empty
 };
 

@@ -104,6 +104,9 @@ std::string sensorConfig(const std::string& config, const player::SensorCalibrat
                                           " unevenly spaced beams the odometry has no model for; give "
                                           "beams: {model: uniform, count, elevation_deg} or hdl64");
   }
+  // The user's sensor stores its points on their rays unless its calibration says otherwise (the
+  // pipeline's default, 0.22 deg, is KITTI's HDL-64E).
+  cfg["lidar"]["vertical_angle_error_deg"] = calib.vertical_angle_error_deg;
   YAML::Node features = cfg["odometry"]["features"];
   features["beam_model"] = model;
   if (model == "uniform") {

@@ -47,6 +47,7 @@ void writePcdFolderFiles(const fs::path& dir, const Scenario& scenario, const st
     c << "  model: uniform\n  count: " << s.beams << "\n  elevation_deg: [" << s.top_elevation_deg << ", "
       << s.bottom_elevation_deg << "]\n";
   c << "range_m: [" << s.min_range_m << ", " << s.max_range_m << "]\n"
+    << "vertical_angle_error_deg: " << s.vertical_angle_error_deg << "  # the points lie this far below their rays\n"
     << "camera_calib: ../training/calib/" << sequence << ".txt  # the detection files are in camera coordinates\n";
 }
 

@@ -14,20 +14,22 @@
 
 namespace dlslot {
 
-// Raises each point's elevation (seen from the lidar's origin) by `angle_rad`, keeping its range
-// and azimuth: the stored point moved back onto its ray. 0 leaves the points.
+// Raises a point's elevation (seen from the lidar's origin) by the angle of cosine `c` and sine
+// `s`, keeping its range and azimuth: the stored point moved back onto its ray.
+inline void raiseElevation(float& x, float& y, float& z, float c, float s) {
+  const float rho = std::sqrt(x * x + y * y);
+  if (rho <= 0) return;  // straight up or down: no azimuth to keep, no lidar fires there
+  const float rho2 = rho * c - z * s;
+  z = rho * s + z * c;
+  x *= rho2 / rho;
+  y *= rho2 / rho;
+}
+
+// Every point of `points` moved back onto its ray (raiseElevation by `angle_rad`); 0 leaves them.
 inline void correctElevation(PointCloud& points, double angle_rad) {
   if (angle_rad == 0) return;
   const float c = static_cast<float>(std::cos(angle_rad)), s = static_cast<float>(std::sin(angle_rad));
-  for (Eigen::Index i = 0; i < points.cols(); ++i) {
-    const float x = points(0, i), y = points(1, i), z = points(2, i);
-    const float rho = std::sqrt(x * x + y * y);
-    if (rho <= 0) continue;  // straight up or down: no azimuth to keep, no lidar fires there
-    const float rho2 = rho * c - z * s;
-    points(0, i) = x * (rho2 / rho);
-    points(1, i) = y * (rho2 / rho);
-    points(2, i) = rho * s + z * c;
-  }
+  for (Eigen::Index i = 0; i < points.cols(); ++i) raiseElevation(points(0, i), points(1, i), points(2, i), c, s);
 }
 
 }  // namespace dlslot

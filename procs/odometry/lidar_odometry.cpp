@@ -105,7 +105,8 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
   cpu = threadCpuMs();
   ScanFeatures features = extractFeatures(frame.scan, cfg_.features, inside.empty() ? nullptr : &inside);
   out.detail.emplace_back("feature_extraction", threadCpuMs() - cpu);
-  // Put back on their rays (the sensor's frame at firing time, so before the de-skew), then moved to the scan's reference instant with the vehicle's motion of the previous frame
+  // Put back on their rays (in the sensor's frame at firing time, so before the de-skew), then
+  // moved to the scan's reference instant with the vehicle's motion of the previous frame
   // (feature_deskew.hpp); the first scans, before any motion is known, stay as they are.
   cpu = threadCpuMs();
   correctElevation(features, cfg_.vertical_angle_error_rad);

@@ -67,4 +67,26 @@ TEST(PipelineInput, ABadCalibrationIsRefusedNamingTheFileAndKey) {
   EXPECT_NE(run.output().find("elevation_deg"), std::string::npos) << run.output();
 }
 
+// A simulated lidar without KITTI's vertical-angle error, its scans written de-skewed: the run
+// corrects for neither (the shipped config's lidar section is KITTI's: 0.22 deg, a 0.1 s sweep),
+// and says so in its config.yaml.
+TEST(PipelineInput, AScenarioRunTakesItsLidarFromTheSimulator) {
+  const std::string out = scratchDir(), scenario = out + "/plain-lidar.yaml";
+  std::ofstream(scenario) << readText(sourceDir() + "/config/scenarios/intersection.yaml")
+                          << "\nsensor:\n  vertical_angle_error_deg: 0\n  deskewed: true\n";
+  ChildProcess run({bin("dlslot-run"), "--config", config(), "--scenario", scenario, "--frames", "5", "--seed", "2",
+                    "--no-render", "--no-map", "--no-eval", "--quiet", "--out", out + "/run"},
+                   out + "/run.log");
+  ASSERT_EQ(run.wait(300), 0) << run.output();
+  const YAML::Node shipped = YAML::LoadFile(config())["lidar"];
+  EXPECT_NEAR(shipped["vertical_angle_error_deg"].as<double>(), 0.22, 1e-12);
+  EXPECT_GT(shipped["sweep_period_s"].as<double>(), 0.0);
+  const YAML::Node lidar = YAML::LoadFile(out + "/run/config.yaml")["lidar"];
+  EXPECT_EQ(lidar["vertical_angle_error_deg"].as<double>(), 0.0);
+  EXPECT_EQ(lidar["sweep_period_s"].as<double>(), 0.0);
+  // The rest of the config is the one given.
+  EXPECT_EQ(YAML::LoadFile(out + "/run/config.yaml")["backend"]["window_size"].as<int>(),
+            YAML::LoadFile(config())["backend"]["window_size"].as<int>());
+}
+
 }  // namespace

@@ -1,6 +1,7 @@
 // dlslot-sim writes what it simulated: the same seed gives the same bytes, and the KITTI files
 // read back through kitti::SequenceReader (the player's reader) give the generated ground truth.
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -57,7 +58,7 @@ TEST(SimSequence, SameSeedSameBytesOtherSeedOtherBytes) {
   std::map<std::string, uint64_t> fa, fb;
   EXPECT_EQ(hashTree(a, &fa), hashTree(b, &fb));
   EXPECT_EQ(fa, fb);
-  EXPECT_EQ(fa.size(), 4u + 6u);  // 4 scans, label, detections, calib, oxts, poses, scenario.yaml
+  EXPECT_EQ(fa.size(), 4u + 7u);  // 4 scans, label, detections, calib, oxts, poses, scenario.yaml, lidar.yaml
   EXPECT_NE(hashTree(a), hashTree(c));
   for (const fs::path& d : {a, b, c}) fs::remove_all(d);
 }
@@ -82,6 +83,11 @@ TEST(SimSequence, ReaderGetsBackTheGeneratedGroundTruth) {
   sim::writeSequence(sc, frames, sc.seed, dir.string(), "0003", {2, false});
   ASSERT_TRUE(fs::exists(dir / "scenario.yaml"));
   EXPECT_EQ(sim::loadScenario((dir / "scenario.yaml").string()).seed, sc.seed);
+  // How the scans were stored, as the pipeline config's lidar section: the default sensor is KITTI's.
+  const YAML::Node lidar = YAML::LoadFile((dir / "lidar.yaml").string())["lidar"];
+  EXPECT_DOUBLE_EQ(lidar["sweep_period_s"].as<double>(), sc.frame_period_s);
+  EXPECT_TRUE(lidar["sweep_clockwise"].as<bool>());
+  EXPECT_DOUBLE_EQ(lidar["vertical_angle_error_deg"].as<double>(), sc.sensor.vertical_angle_error_deg);
 
   sim::Simulation sim(sc);  // the same scenario and seed: the same drive
   const std::vector<Pose> poses = sim.lidarPoses();

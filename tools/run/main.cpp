@@ -124,6 +124,24 @@ std::string sensorConfig(const std::string& config, const player::SensorCalibrat
   return path;
 }
 
+// The run's config for a simulated sequence: the simulator's description of its scans
+// (ROOT/lidar.yaml: sweep timing, vertical-angle error) in place of the config's lidar section,
+// written to OUT/config.yaml, which every process then reads.
+std::string simulatedSensorConfig(const std::string& config, const std::string& root, const std::string& out) {
+  const std::string lidar_file = root + "/lidar.yaml";
+  YAML::Node cfg = YAML::LoadFile(config);
+  const YAML::Node lidar = YAML::LoadFile(lidar_file)["lidar"];
+  if (!lidar || !lidar.IsMap()) throw InputError(lidar_file, 0, "expected a 'lidar' section");
+  for (const auto& kv : lidar) cfg["lidar"][kv.first.as<std::string>()] = kv.second;
+  const std::string path = out + "/config.yaml";
+  std::ofstream f(path);
+  f << "# " << config << " with the simulated sensor of " << lidar_file << "\n" << cfg << "\n";
+  if (!f) throw std::runtime_error(path + ": cannot write");
+  std::cerr << "sensor: the simulator's lidar (sweep " << lidar["sweep_period_s"].as<double>() << " s, vertical-angle error "
+            << lidar["vertical_angle_error_deg"].as<double>() << " deg); config " << path << "\n";
+  return path;
+}
+
 std::string binDir() { return fs::read_symlink("/proc/self/exe").parent_path().string(); }
 
 // Runs a command to completion with output to log; returns its exit code.
@@ -306,6 +324,7 @@ int runPipeline(int argc, char** argv) {
     if (runToEnd(sup, "sim", sim, logs + "/sim.log") != 0)
       throw Failure("dlslot-sim failed:\n" + sup.tail("sim"));
     detections = geometric ? std::vector<std::string>{} : std::vector<std::string>{root + "/detections/sim"};
+    config = simulatedSensorConfig(config, root, out);
   }
   const int num_frames = input.empty() ? kitti::locateSequence(root, sequence).num_frames
                                        : static_cast<int>(player::openScanFolder(input, player::readSensorCalibration(sensor_calib)).files.size());

@@ -51,6 +51,21 @@ void writePcdFolderFiles(const fs::path& dir, const Scenario& scenario, const st
     << "camera_calib: ../training/calib/" << sequence << ".txt  # the detection files are in camera coordinates\n";
 }
 
+// The pipeline config's `lidar` section that describes these scans (config/dlslot.yaml's
+// defaults are KITTI's, which the default sensor reproduces; a scenario that turns the vertical
+// error or the motion distortion off would otherwise be corrected for what its scans do not have).
+void writeLidarSection(const fs::path& file, const Scenario& scenario) {
+  const SensorSpec& s = scenario.sensor;
+  std::ofstream f(file);
+  f << "# How dlslot-sim stored these scans (scenario " << scenario.name << "): the `lidar` section of the\n"
+    << "# pipeline's config for them; dlslot-run --scenario merges it into the run's config.yaml.\n"
+    << "lidar:\n"
+    << "  sweep_period_s: " << (s.motion_distortion && !s.deskewed ? scenario.frame_period_s : 0.0) << "\n"
+    << "  sweep_clockwise: true\n"
+    << "  vertical_angle_error_deg: " << s.vertical_angle_error_deg << "\n";
+  if (!f) throw std::runtime_error(file.string() + ": cannot write");
+}
+
 }  // namespace
 
 SequenceStats writeSequence(const Scenario& scenario_in, int frames, uint64_t seed, const std::string& out_dir,
@@ -113,6 +128,7 @@ SequenceStats writeSequence(const Scenario& scenario_in, int frames, uint64_t se
   kitti::writeOxts((training / "oxts" / file).string(),
                    simulatedOxts(poses, *sim.calib().T_velo_imu, scenario.frame_period_s));
   writeScenario((root / "scenario.yaml").string(), scenario);
+  writeLidarSection(root / "lidar.yaml", scenario);
   if (options.pcd_folder) writePcdFolderFiles(pcd, scenario, poses, sequence);
 
   stats.mean_points = points / frames;

@@ -9,6 +9,8 @@
 //   training/poses/SSSS.txt             T_world_lidar, KITTI 3x4 rows, world = first scan's lidar frame
 //   detections/sim/SSSS.txt             simulated detections (tracking format + score)
 //   scenario.yaml                       the scenario with the seed and frame count used
+//   lidar.yaml                          how the scans were stored: the pipeline config's `lidar`
+//                                       section for them (dlslot-run --scenario merges it)
 #pragma once
 
 #include <cstdint>

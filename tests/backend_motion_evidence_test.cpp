@@ -44,6 +44,34 @@ TEST(BackendMotionEvidence, FitAmongOutliersLeavesOutAnotherObjectsBox) {
   EXPECT_TRUE(fitSpeedAmongOutliers({p[0], p[1], p[2]}, 0.3, 5.0)->velocity.isApprox(fitSpeed({p[0], p[1], p[2]}, 0.3)->velocity, 1e-12));
 }
 
+// highway-jam seed 2: two oncoming cars in adjacent lanes (3.5 m apart, -22 m/s) given one track
+// by the tracker, two boxes each, 70 m away (sigma 0.36 m, gate 1.8 m). The consensus of pairs
+// found a line through one box of each and a third within the gate: 10 m/s sideways, -4.4 m/s
+// along the road once turned to the heading. A vehicle's pairs that moved across its heading by
+// more than the gate are two objects: the line through one car's boxes.
+TEST(BackendMotionEvidence, AVehiclesLineIsNotDrawnAcrossTwoLanes) {
+  const std::vector<TimedPosition> p{{11.5, Eigen::Vector3d(155.72, 4.57, 0)},
+                                     {11.6, Eigen::Vector3d(153.49, 4.65, 0)},
+                                     {11.8, Eigen::Vector3d(155.61, 8.07, 0)},
+                                     {11.9, Eigen::Vector3d(153.51, 8.42, 0)}};
+  const auto sideways = fitSpeedAmongOutliers(p, 0.36, 5.0);
+  ASSERT_TRUE(sideways);
+  EXPECT_GT(std::abs(sideways->velocity.y()), 5.0);
+  const Eigen::Vector2d heading(-1.0, 0.0);
+  const auto along = fitSpeedAmongOutliers(p, 0.36, 5.0, &heading);
+  ASSERT_TRUE(along);
+  EXPECT_NEAR(along->velocity.x(), -22.3, 0.05);  // the first car's two boxes
+  EXPECT_LT(std::abs(along->velocity.y()), 1.0);
+  // Three positions, one of them the other car's: outvoted with a heading, not without.
+  const std::vector<TimedPosition> three{p[0], p[1], p[2]};
+  EXPECT_NEAR(fitSpeedAmongOutliers(three, 0.36, 5.0, &heading)->velocity.x(), -22.3, 0.05);
+  EXPECT_TRUE(fitSpeedAmongOutliers(three, 0.36, 5.0)->velocity.isApprox(fitSpeed(three, 0.36)->velocity, 1e-12));
+  // Boxes that all move along the heading: every one kept, the plain line.
+  std::vector<TimedPosition> lane;
+  for (int k = 0; k < 6; ++k) lane.push_back({0.1 * k, Eigen::Vector3d(-2.2 * k, (k % 2 ? 0.2 : -0.2), 0)});
+  EXPECT_TRUE(fitSpeedAmongOutliers(lane, 0.2, 5.0, &heading)->velocity.isApprox(fitSpeed(lane, 0.2)->velocity, 1e-12));
+}
+
 TEST(BackendMotionEvidence, VelocityAlongHeadingWeighsTheTwoEstimates) {
   SpeedFit fit;
   fit.velocity = Eigen::Vector3d(10.0, 1.0, 0.3);  // 1 m/s across a heading along x

@@ -25,9 +25,12 @@ struct SpeedFit {
 // of a few sigmas is evidence of motion.
 std::optional<SpeedFit> fitSpeed(const std::vector<TimedPosition>& positions, double position_sigma);
 // The same line with the boxes the tracker gave the wrong track left out: the consensus of the
-// pairs of positions (more than 3 positions; else fitSpeed).
+// pairs of positions (more than 3 positions; else fitSpeed). With a vehicle's unit bird's-eye
+// `heading`, a pair that moved across it by more than the inlier gate is not a candidate (a
+// vehicle does not move sideways: the two boxes are two objects), which also lets 3 positions
+// outvote one.
 std::optional<SpeedFit> fitSpeedAmongOutliers(const std::vector<TimedPosition>& positions, double position_sigma,
-                                              double inlier_sigmas);
+                                              double inlier_sigmas, const Eigen::Vector2d* heading = nullptr);
 
 // A wheeled vehicle moves along its heading. The fit's velocity component across the unit
 // bird's-eye `heading` is that of positions alone (standard deviation fit.sigma); the heading

@@ -11,9 +11,8 @@ namespace dlslot::mapper {
 struct LoopConfig {
   bool enabled = true;
   // The registered clouds de-skewed with the ego's motion and put back on their rays
-  // (vertical_angle_error_rad): off by default, since on urban-loop seed 10 it let a registration
-  // slid 9.6 m along a street pass the acceptance test (docs/mapping.md).
-  bool correct_clouds = false;
+  // (vertical_angle_error_rad), as the odometry's features are (config/dlslot.yaml says why).
+  bool correct_clouds = true;
   int rings = 20, sectors = 60;
   double max_radius_m = 50.0;
   double min_separation_m = 100.0, search_radius_m = 40.0;

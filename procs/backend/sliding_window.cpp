@@ -317,7 +317,7 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
   keep();
 }
 
-std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track) const {
+std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track, const std::optional<BoxHeading>& heading) const {
   std::vector<TimedPosition> positions;
   double range_sum = 0;
   for (const auto& [f, obs] : track.observations) {
@@ -333,7 +333,6 @@ std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track) const {
   // associations, often before a gap). 5 left every tuning run's velocity RMSE as it was but
   // highway-jam 3's (0.786 -> 0.556 m/s: an oncoming van whose first box was another's); 3 and 2
   // also dropped good boxes of young tracks (highway-jam 2: 0.515 -> 0.533 and 0.548 m/s).
-  const std::optional<BoxHeading> heading = boxHeading(track);
   return fitSpeedAmongOutliers(positions, sigma, 5.0, heading ? &heading->direction : nullptr);
 }
 
@@ -353,13 +352,13 @@ std::optional<SlidingWindow::BoxHeading> SlidingWindow::boxHeading(const Track& 
 }
 
 std::optional<SlidingWindow::LineVelocity> SlidingWindow::boxLineVelocity(const Track& track) const {
-  const std::optional<SpeedFit> fit = windowMotion(track);
+  const std::optional<BoxHeading> box_heading = boxHeading(track);
+  const std::optional<SpeedFit> fit = windowMotion(track, box_heading);
   if (!fit) return std::nullopt;
   LineVelocity line;
   line.velocity = fit->velocity;
   const double var_fit = std::max(fit->sigma * fit->sigma, 1e-6);
   line.covariance = var_fit * Eigen::Matrix2d::Identity();
-  const std::optional<BoxHeading> box_heading = boxHeading(track);
   if (!box_heading) return line;
   const Eigen::Vector2d& heading = box_heading->direction;
   const double heading_sigma = box_heading->sigma;
@@ -394,7 +393,7 @@ Eigen::Vector3d SlidingWindow::youngVehicleVelocity(const Track& track, const Li
 void SlidingWindow::startTrack(Track& track, int frame) {
   // Static or dynamic from the positions of the trajectory in the window (III-D); the tracker's
   // guess only when the window has too little of it.
-  const std::optional<SpeedFit> fit = windowMotion(track);
+  const std::optional<SpeedFit> fit = windowMotion(track, boxHeading(track));
   const bool dynamic = fit ? fit->speed > config_.static_max_speed && fit->speed > config_.dynamic_min_sigmas * fit->sigma
                            : track.dynamic_guess;
   track.model = dynamic ? TrackModel::kDynamic : TrackModel::kStatic;

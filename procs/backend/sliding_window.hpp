@@ -113,9 +113,6 @@ class SlidingWindow {
   // A young vehicle's line velocity fused with the velocities its registrations in the window
   // measured (registered_velocity.hpp); the line as it is without registrations.
   Eigen::Vector3d youngVehicleVelocity(const Track& track, const LineVelocity& line) const;
-  // The least-squares motion of the track's observed positions in the window (world frame),
-  // boxes of another object left out (for a vehicle, also those that moved across its heading).
-  std::optional<SpeedFit> windowMotion(const Track& track) const;
   // A vehicle's mean bird's-eye heading over its boxes in the window and its standard deviation
   // (rad); none for other classes.
   struct BoxHeading {
@@ -123,6 +120,9 @@ class SlidingWindow {
     double sigma = 0;
   };
   std::optional<BoxHeading> boxHeading(const Track& track) const;
+  // The least-squares motion of the track's observed positions in the window (world frame),
+  // boxes of another object left out (with a vehicle's heading, also those that moved across it).
+  std::optional<SpeedFit> windowMotion(const Track& track, const std::optional<BoxHeading>& heading) const;
   void addTrackObservation(Track& track, int frame);
   void extendChain(Track& track, int frame, const Pose& o);
   int switchMovingLandmarks();

@@ -81,6 +81,15 @@ std::string detectionSource(const std::string& requested, bool have_files, bool 
   return "geometric";
 }
 
+// Writes the run's config, OUT/config.yaml, which every process then reads; returns its path.
+std::string writeRunConfig(const YAML::Node& cfg, const std::string& what, const std::string& out) {
+  const std::string path = out + "/config.yaml";
+  std::ofstream f(path);
+  f << "# " << what << "\n" << cfg << "\n";
+  if (!f) throw std::runtime_error(path + ": cannot write");
+  return path;
+}
+
 // The run's config for a folder of the user's scans: the odometry's beam model (and the
 // detector's top beam) from the sensor calibration, or estimated from the first scan. Written to
 // OUT/config.yaml, which every process then reads.
@@ -115,10 +124,7 @@ std::string sensorConfig(const std::string& config, const player::SensorCalibrat
     features["max_vertical_deg"] = top;
     cfg["detector"]["classes"]["top_beam_deg"] = top;
   }
-  const std::string path = out + "/config.yaml";
-  std::ofstream f(path);
-  f << "# " << config << " with the sensor of " << calib.path << "\n" << cfg << "\n";
-  if (!f) throw std::runtime_error(path + ": cannot write");
+  const std::string path = writeRunConfig(cfg, config + " with the sensor of " + calib.path, out);
   std::cerr << "sensor: odometry beam model " << model
             << (model == "uniform" ? " (" + std::to_string(beams) + " beams)" : std::string()) << "; config " << path << "\n";
   return path;
@@ -133,10 +139,7 @@ std::string simulatedSensorConfig(const std::string& config, const std::string& 
   const YAML::Node lidar = YAML::LoadFile(lidar_file)["lidar"];
   if (!lidar || !lidar.IsMap()) throw InputError(lidar_file, 0, "expected a 'lidar' section");
   for (const auto& kv : lidar) cfg["lidar"][kv.first.as<std::string>()] = kv.second;
-  const std::string path = out + "/config.yaml";
-  std::ofstream f(path);
-  f << "# " << config << " with the simulated sensor of " << lidar_file << "\n" << cfg << "\n";
-  if (!f) throw std::runtime_error(path + ": cannot write");
+  const std::string path = writeRunConfig(cfg, config + " with the simulated sensor of " + lidar_file, out);
   std::cerr << "sensor: the simulator's lidar (sweep " << lidar["sweep_period_s"].as<double>() << " s, vertical-angle error "
             << lidar["vertical_angle_error_deg"].as<double>() << " deg); config " << path << "\n";
   return path;

@@ -28,6 +28,7 @@
 #include "mapper/voxel_map.hpp"
 #include "dlslot/cpu_clock.hpp"
 #include "dlslot/message_auth.hpp"
+#include "dlslot/vertical_angle.hpp"
 #include "dlslot/voxel_key.hpp"
 
 using namespace dlslot;
@@ -558,7 +559,7 @@ TEST(Mapper, ACarPassingBesideTheEgoIsRemovedWhereTheSweepSawItAndThePoleBesideI
   EXPECT_GT(now.rail_kept, 400);
   // The same scene with every box at the reference instant (as for de-skewed scans): the car's
   // trailing points stay and the pole goes, although the box is grown by the same 0.3 m.
-  config.sweep.period_s = 0;
+  config.lidar.sweep.period_s = 0;
   const PassingCar still = passCar(config);
   EXPECT_GT(still.ghost, 0);
   EXPECT_GT(still.pole_removed, 0);
@@ -704,7 +705,7 @@ TEST(LoopCloser, ConsecutiveQueriesEachKeepTheirLoopEdge) {
     c.quiet_keyframes = quiet;
     c.start_steps = 0;  // the drift is small: the prior alone (several starts: the verifier's test)
     c.submap_keyframes = 1;
-    LoopCloser closer(c, /*threaded=*/false);
+    LoopCloser closer(c, LidarConfig{}, /*threaded=*/false);
     Pose odo = poseXYYaw(-30, 0, 0);
     Pose last_truth = odo;
     int id = 0;
@@ -736,6 +737,59 @@ TEST(LoopCloser, ConsecutiveQueriesEachKeepTheirLoopEdge) {
   ASSERT_GE(quiet.size(), 1u);
   for (size_t i = 1; i < quiet.size(); ++i) EXPECT_GE(quiet[i] - quiet[i - 1], 10);
   EXPECT_GT(every.size(), quiet.size());
+}
+
+// KITTI stores each point a little below its ray (lidar.vertical_angle_error_deg), so a scan sees
+// the flat ground as a shallow cone around itself. Two keyframes metres apart see two cones with
+// different apexes, which register best tilted: the loop edge's error. The loop closer puts its
+// sampled points back on their rays first (LoopConfig::correct_clouds).
+TEST(LoopCloser, PutsItsCloudsBackOnTheirRaysBeforeRegistering) {
+  const std::vector<Eigen::Vector3d> world = streetWorld();
+  LidarConfig lidar;
+  lidar.sweep.period_s = 0;  // de-skewed scans: only the cone here
+  lidar.vertical_angle_error_rad = 1.0 * M_PI / 180;  // KITTI's 0.22 deg, enlarged so that the tilt stands out
+  const float c = static_cast<float>(std::cos(-lidar.vertical_angle_error_rad)),
+              s = static_cast<float>(std::sin(-lidar.vertical_angle_error_rad));
+  // The largest tilt (deg) of an accepted loop edge against the truth, and the number accepted.
+  auto drive = [&](bool correct) {
+    LoopConfig config = loopConfig();
+    config.correct_clouds = correct;
+    config.min_separation_m = 30;
+    config.start_steps = 0;
+    config.submap_keyframes = 1;
+    LoopCloser closer(config, lidar, /*threaded=*/false);
+    std::vector<Pose> truth;
+    auto add = [&](const Pose& T) {
+      KeyframeInput kf;
+      kf.id = kf.frame = static_cast<int>(truth.size());
+      kf.odometry = T;
+      kf.points = view(world, T);
+      for (Eigen::Index i = 0; i < kf.points.cols(); ++i)  // stored below the ray
+        raiseElevation(kf.points(0, i), kf.points(1, i), kf.points(2, i), c, s);
+      truth.push_back(T);
+      closer.add(std::move(kf));
+    };
+    for (double x = -15; x <= 15; x += 3) add(poseXYYaw(x, 0, 0));
+    for (double x = 13.5; x >= 0; x -= 3) add(poseXYYaw(x, -1.5, M_PI));  // between the first pass's keyframes
+    double tilt = 0;
+    int accepted = 0;
+    for (const LoopEvent& e : closer.allEvents()) {
+      if (!e.verdict.accepted) continue;
+      ++accepted;
+      const Pose error = (truth[e.match_keyframe].inverse() * truth[e.query_keyframe]).inverse() * e.verdict.registration.T_match_query;
+      const double cos_tilt = std::clamp((error.linear() * Eigen::Vector3d::UnitZ()).z(), -1.0, 1.0);
+      tilt = std::max(tilt, std::acos(cos_tilt) * 180 / M_PI);
+    }
+    return std::make_pair(tilt, accepted);
+  };
+  const auto [stored_tilt, stored_accepted] = drive(false);
+  const auto [tilt, accepted] = drive(true);
+  std::printf("largest tilt of a loop edge: %.3f deg as stored (%d accepted), %.3f deg corrected (%d)\n", stored_tilt,
+              stored_accepted, tilt, accepted);
+  ASSERT_GE(stored_accepted, 1);
+  ASSERT_GE(accepted, 1);
+  EXPECT_GT(stored_tilt, 0.2);
+  EXPECT_LT(tilt, 0.5 * stored_tilt);
 }
 
 // The opener must give the receiving thread exactly what opening on it gave: every scan, in the

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "dlslot/deskew.hpp"
 #include "mapper/idle_worker.hpp"
 #include "mapper/loop_verifier.hpp"
 #include "mapper/mapper_config.hpp"
@@ -23,7 +24,8 @@ struct KeyframeInput {
   int id = 0;     // 0, 1, 2, ... in order
   int frame = 0;  // scan index
   Pose odometry = Pose::Identity();  // T_world_lidar from SLOT_STATE
-  PointCloud points;                 // static points, lidar frame
+  PointCloud points;                 // static points, lidar frame, as stored
+  BodyTwist twist;                   // the ego's motion over the keyframe's sweep (for de-skewing)
   bool keep_cloud = true;            // false: used as a query now, not kept as a candidate (a place already held)
   bool last = false;                 // the run's last keyframe: its nearest candidate is always verified
 };
@@ -40,8 +42,9 @@ class LoopCloser {
   // threaded: verification on a worker thread (live; idle_priority: at SCHED_IDLE, idle_worker.hpp)
   // with at most `capacity` keyframes waiting (add() blocks beyond); else inline in add()
   // (offline, reproducible).
-  LoopCloser(const LoopConfig& config, bool threaded, size_t capacity = 64, bool idle_priority = false,
-             double cpu_share = 1.0);
+  // lidar: how the scans were taken (for LoopConfig::correct_clouds).
+  LoopCloser(const LoopConfig& config, const LidarConfig& lidar, bool threaded, size_t capacity = 64,
+             bool idle_priority = false, double cpu_share = 1.0);
   ~LoopCloser();
   LoopCloser(const LoopCloser&) = delete;
   LoopCloser& operator=(const LoopCloser&) = delete;
@@ -60,7 +63,8 @@ class LoopCloser {
   std::vector<LoopEvent> allEvents() const;
   int accepted() const;
   int rejected() const;
-  // CPU milliseconds per keyframe spent here (descriptor, search, verification, optimization).
+  // CPU milliseconds per keyframe spent here (correction, sampling, descriptor, search, verification,
+  // optimization).
   std::vector<double> timesMs() const;
 
  private:
@@ -71,10 +75,11 @@ class LoopCloser {
     Pose odometry;
     double path_m = 0;
     ScanContext descriptor;
-    PointCloud cloud;  // downsampled to registration_voxel_m; empty when not kept
+    PointCloud cloud;  // downsampled to registration_voxel_m (and corrected); empty when not kept
     bool candidate = true;  // its cloud and descriptor are kept
   };
   LoopConfig config_;
+  LidarConfig lidar_;
   ScanContextParams sc_params_;
   // Owned by the worker.
   std::vector<Keyframe> keyframes_;

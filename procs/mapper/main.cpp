@@ -96,7 +96,7 @@ void printSummary(const Mapper& mapper, const std::string& out, const std::vecto
               mapper.loops().accepted(), mapper.loops().rejected());
   std::printf("  keyframe thread: %d scans deferred (it was %zu keyframes behind at most, bound %d)\n",
               mapper.keyframesDeferred(), mapper.maxBacklog(), mapper.config().max_backlog_keyframes);
-  std::printf("  per keyframe, CPU: decoding + removal + map %.2f ms mean; loop thread (descriptor, search, verification, "
+  std::printf("  per keyframe, CPU: decoding + removal + map %.2f ms mean; loop thread (clouds corrected, descriptor, search, verification, "
               "graph) %.2f ms mean, %.2f p95, %.1f max\n",
               mapper.keyframes().empty() ? 0.0 : mapper.keyframeMs() / mapper.keyframes().size(), loop.mean(),
               loop.percentile(95), loop.max());
@@ -308,9 +308,7 @@ int main(int argc, char** argv) {
     ConfigSection section = root.section("mapper");
     MapperConfig config = MapperConfig::read(section);
     section.finish();
-    const LidarConfig lidar = LidarConfig::read(root.section("lidar"));
-    config.sweep = lidar.sweep;
-    config.vertical_angle_error_rad = lidar.vertical_angle_error_rad;
+    config.lidar = LidarConfig::read(root.section("lidar"));
     if (!remove.empty()) config.remove_movable = remove == "movable";
     if (no_loops) config.loop.enabled = false;
     config.join_timeout_s = join_timeout.resolve(config.join_timeout_s);

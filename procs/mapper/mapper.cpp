@@ -4,7 +4,6 @@
 #include <memory>
 
 #include "dlslot/cpu_clock.hpp"
-#include "dlslot/vertical_angle.hpp"
 #include "mapper/box_cutter.hpp"
 
 namespace dlslot::mapper {
@@ -14,7 +13,7 @@ Mapper::Mapper(const MapperConfig& config, bool threaded)
       boxes_(config.box_margin_m, config.follow_frames, config.remove_movable, config.ground_clearance_m),
       map_(config.map_voxel_m),
       removed_(config.map_voxel_m),
-      loops_(std::make_unique<LoopCloser>(config.loop, threaded, static_cast<size_t>(config.max_backlog_keyframes),
+      loops_(std::make_unique<LoopCloser>(config.loop, config.lidar, threaded, static_cast<size_t>(config.max_backlog_keyframes),
                                           config.idle_priority, config.live_cpu_share)),
       // Every keyframe admitted while the backlog was below the bound must fit without blocking the
       // caller: those still in their decision delay (one per scan at most) come on top of the bound.
@@ -195,7 +194,7 @@ void Mapper::commit(Pending& p, const std::vector<MovingBox>& boxes, const BodyT
     }
   }
   // The removal test (box_cutter.hpp), each box where it was at each point's firing time.
-  const BoxCutter cutter(boxes, config_.max_range_m, config_.sweep);
+  const BoxCutter cutter(boxes, config_.max_range_m, config_.lidar.sweep);
   PointCloud kept(4, n), gone(4, n);
   Eigen::Index nk = 0, ng = 0;
   for (Eigen::Index i = 0; i < n; ++i) (cutter.inside(scan.col(i).head<3>()) ? gone.col(ng++) : kept.col(nk++)) = scan.col(i);
@@ -215,17 +214,7 @@ void Mapper::commit(Pending& p, const std::vector<MovingBox>& boxes, const BodyT
   // loop closer's memory, like the map's, stops growing when the map does (driving in circles,
   // standing in traffic).
   const bool keep_cloud = static_cast<double>(fresh) >= config_.min_new_fraction * static_cast<double>(std::max<Eigen::Index>(nk, 1));
-  // With loop.correct_clouds: the loop closer registers keyframes tens of metres apart, driven at
-  // different speeds and turn rates; each point is put back on its ray (vertical_angle.hpp:
-  // uncorrected, the two sides' ground cones fit best tilted) and then into the frame of the scan's
-  // reference instant (deskew.hpp: skewed, the two sides differ by a shear that registration reads
-  // as a rotation). The map keeps the points as stored, where its removal and the evaluation's
-  // truth test them (each box at each point's firing time, each map point one of its scan's).
-  if (config_.loop.correct_clouds) {
-    correctElevation(kept, config_.vertical_angle_error_rad);
-    deskew(kept, config_.sweep, twist);
-  }
-  loops_->add({id, p.frame, p.pose, std::move(kept), keep_cloud, p.last});
+  loops_->add({id, p.frame, p.pose, std::move(kept), twist, keep_cloud, p.last});
   applyLoopResult();
 }
 

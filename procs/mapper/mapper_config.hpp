@@ -4,7 +4,6 @@
 #include <string>
 
 #include "dlslot/config.hpp"
-#include "dlslot/sweep_timing.hpp"
 
 namespace dlslot::mapper {
 
@@ -43,11 +42,10 @@ struct MapperConfig {
   bool remove_movable = false;  // remove: movable (every track) instead of dynamic (moving tracks)
   double box_margin_m = 0.7;
   double ground_clearance_m = 0.1;
-  // From the config's lidar section (LidarConfig): the scans' firing order (a moving object's points
-  // lie in its box moved by its motion relative to the lidar until the instant they were fired), and
-  // how far below its ray each point is stored (the loop closer's clouds may be corrected by it).
-  SweepTiming sweep;
-  double vertical_angle_error_rad = 0.0;
+  // The config's lidar section: the scans' firing order (a moving object's points lie in its box
+  // moved by its motion relative to the lidar until the instant they were fired), and how far below
+  // its ray each point is stored (the loop closer's clouds may be corrected by both).
+  LidarConfig lidar;
   double min_new_fraction = 0.01;  // a keyframe keeps its loop-closure cloud when this share of its points made new voxels
   int decision_delay_frames = 15, follow_frames = 15;
   double join_timeout_s = 5.0;  // live: how long a scan waits for its SLOT_STATE (and back)

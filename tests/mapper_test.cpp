@@ -741,8 +741,8 @@ TEST(LoopCloser, ConsecutiveQueriesEachKeepTheirLoopEdge) {
 
 // KITTI stores each point a little below its ray (lidar.vertical_angle_error_deg), so a scan sees
 // the flat ground as a shallow cone around itself. Two keyframes metres apart see two cones with
-// different apexes, which register best tilted: the loop edge's error. The loop closer puts its
-// sampled points back on their rays first (LoopConfig::correct_clouds).
+// different apexes, which register best tilted: the loop edge's error. The loop closer puts the
+// points back on their rays before it samples and registers them (LoopConfig::correct_clouds).
 TEST(LoopCloser, PutsItsCloudsBackOnTheirRaysBeforeRegistering) {
   const std::vector<Eigen::Vector3d> world = streetWorld();
   LidarConfig lidar;

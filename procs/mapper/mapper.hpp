@@ -122,9 +122,9 @@ class Mapper {
   // On the caller's thread: the ego's motion over the keyframe's sweep, from its neighbouring scans.
   BodyTwist egoTwist(const Pending& p) const;
   // On the keyframe thread: decode, crop, remove what is inside `boxes` (lidar frame), insert;
-  // the loop closer gets the kept points with `twist` to correct them by. The map keeps
-  // the points as stored, where its removal and the evaluation's truth test them (each box at each
-  // point's firing time, each map point one of its scan's).
+  // the kept points go on to the loop closer with `twist`, which corrects them for registration.
+  // The map keeps the points as stored, where its removal and the evaluation's truth test them
+  // (each box at each point's firing time, each map point one of its scan's).
   void commit(Pending& p, const std::vector<MovingBox>& boxes, const BodyTwist& twist);
   void applyLoopResult();
 

@@ -20,6 +20,7 @@
 #include "backend/observation_factor.hpp"
 #include "backend/odometry_factor.hpp"
 #include "backend/pose_change_factor.hpp"
+#include "backend/registration_factor.hpp"
 #include "backend/vehicle_motion_factor.hpp"
 #include "backend/pose_manifold.hpp"
 #include "backend_scene.hpp"
@@ -207,6 +208,40 @@ TEST(BackendFactors, PoseChangeResidualAndJacobians) {
   const Pose o1 = planarPose(1, 2, 0.3), o2 = planarPose(2, 2.5, 0.35);
   PoseChangeFactor f(Matrix6::Identity());
   EXPECT_LT(residual(f, {toBlock(o1), toBlock(o2), toBlock(o1.inverse() * o2)}).norm(), 1e-12);
+}
+
+TEST(BackendFactors, RegistrationResidualAndJacobians) {
+  std::mt19937 rng(12);
+  for (int i = 0; i < 10; ++i) {
+    const Pose X1 = randomPose(rng), X2 = randomPose(rng), o1 = randomPose(rng), c = randomPose(rng, 1.0, 0.3),
+               E = error(rng);
+    const Matrix6 S = randomSqrtInfo(rng);
+    // A_meas = (X2^-1 o1 c o1^-1 X1) E^-1: the factor's error is E.
+    const Pose A = X2.inverse() * o1 * c * o1.inverse() * X1;
+    RegistrationFactor f(A * E.inverse(), S);
+    const std::vector<Vector7> blocks{toBlock(X1), toBlock(X2), toBlock(o1), toBlock(c)};
+    EXPECT_TRUE(residual(f, blocks).isApprox(S * logPose(E), 1e-9));
+    expectJacobiansMatchNumeric(f, blocks);
+  }
+}
+
+TEST(BackendFactors, RegistrationMeasuresTheObjectAgainstTheSensorNotTheWorld) {
+  // A car 10 m ahead moves 1.5 m along world x while the ego moves 2 m: its points, put into the
+  // world with the ego poses of the time, register to M. Moving both ego poses together moves
+  // nothing; moving the ego's motion by 0.1 m (another odometry) moves the car's by as much: the
+  // measurement is the car against the sensor.
+  const Pose X1 = planarPose(0, 0, 0), X2 = planarPose(2, 0, 0), o1 = planarPose(10, 0, 0),
+             c = planarPose(1.5, 0, 0);
+  const Pose M = o1 * c * o1.inverse();
+  Matrix6 info = Matrix6::Identity() * 1e4;
+  const RegistrationMeasurement rm = registrationMeasurement(M, info, X1, X2);
+  RegistrationFactor f(rm.A_meas, rm.sqrt_info);
+  EXPECT_LT(residual(f, {toBlock(X1), toBlock(X2), toBlock(o1), toBlock(c)}).norm(), 1e-9);
+  const Pose shift = planarPose(3, -1, 0.2);
+  EXPECT_LT(residual(f, {toBlock(shift * X1), toBlock(shift * X2), toBlock(shift * o1), toBlock(c)}).norm(), 1e-6);
+  EXPECT_LT(residual(f, {toBlock(X1), toBlock(planarPose(2.1, 0, 0)), toBlock(o1), toBlock(planarPose(1.6, 0, 0))}).norm(),
+            1e-6);
+  EXPECT_NEAR(residual(f, {toBlock(X1), toBlock(planarPose(2.1, 0, 0)), toBlock(o1), toBlock(c)}).norm(), 0.1 * 100, 1e-6);
 }
 
 TEST(BackendFactors, ConstantVelocityResidualAndJacobians) {

@@ -183,48 +183,9 @@ TEST(ObjectRegistration, OutcomesHaveNames) {
     EXPECT_STRNE(toString(static_cast<RegistrationOutcome>(k)), "?");
 }
 
-// ---- the pose-change measurement factor on eq. 10's c ----
+// ---- a world motion as a pose change (registered_velocity.hpp reads it) ----
 
-TEST(PoseChangeMeasurementFactor, ResidualAndJacobianAgainstNumeric) {
-  std::mt19937 rng(11);
-  std::normal_distribution<double> n(0.0, 1.0);
-  for (int trial = 0; trial < 5; ++trial) {
-    Vector6 a, b;
-    for (int k = 0; k < 6; ++k) {
-      a[k] = (k < 3 ? 1.5 : 0.2) * n(rng);
-      b[k] = (k < 3 ? 0.3 : 0.05) * n(rng);
-    }
-    const Pose c_meas = plus(Pose::Identity(), a), c = plus(c_meas, b);
-    Matrix6 S = Matrix6::Zero();
-    for (int r = 0; r < 6; ++r)
-      for (int k = r; k < 6; ++k) S(r, k) = r == k ? 1.0 + std::abs(n(rng)) : 0.3 * n(rng);
-    PoseChangeMeasurementFactor f(c_meas, S);
-    // At the measurement the residual is zero.
-    const Vector7 x_meas = toBlock(c_meas);
-    const double* pm[] = {x_meas.data()};
-    EXPECT_LT(f.evaluate(pm, nullptr).norm(), 1e-12);
-    // Elsewhere: S Log(c_meas^-1 c), and the tangent Jacobian matches central differences.
-    const Vector7 x = toBlock(c);
-    const double* p[] = {x.data()};
-    Matrix6 J;
-    Matrix6* Jp[] = {&J};
-    const Vector6 r = f.evaluate(p, Jp);
-    EXPECT_LT((r - S * logPose(c_meas.inverse() * c)).norm(), 1e-9);
-    Matrix6 numeric;
-    const double h = 1e-6;
-    for (int k = 0; k < 6; ++k) {
-      Vector6 d = Vector6::Zero();
-      d[k] = h;
-      const Vector7 xp = toBlock(plus(c, d)), xm = toBlock(plus(c, -d));
-      const double* pp[] = {xp.data()};
-      const double* pn[] = {xm.data()};
-      numeric.col(k) = (f.evaluate(pp, nullptr) - f.evaluate(pn, nullptr)) / (2 * h);
-    }
-    EXPECT_LT((J - numeric).norm(), 1e-5 * std::max(1.0, numeric.norm())) << "analytic\n" << J << "\nnumeric\n" << numeric;
-  }
-}
-
-TEST(PoseChangeMeasurementFactor, WorldMotionBecomesTheObjectsPoseChange) {
+TEST(PoseChangeMeasurement, WorldMotionBecomesTheObjectsPoseChange) {
   // An object at o_prev moving by c in its own frame moves the world by M = o_prev c o_prev^-1;
   // the measurement of M gives back c, and information along world x (the only measured
   // direction) becomes information along the object's heading, turned by its yaw.
@@ -238,4 +199,25 @@ TEST(PoseChangeMeasurementFactor, WorldMotionBecomesTheObjectsPoseChange) {
   const Matrix6 info_c = pm.sqrt_info.transpose() * pm.sqrt_info;
   EXPECT_NEAR(info_c(0, 0), 1e4, 50.0);  // along the heading: measured
   EXPECT_LT(std::abs(info_c(1, 1)), 1.0);   // across it: not
+}
+
+TEST(ObjectRegistration, NoRegistrationClaimsMoreThanItsAccuracy) {
+  // Measured to 1 mm along x (a near car's thousand points) and 1 cm along y, yaw to 0.1 deg;
+  // z, roll and pitch unmeasured. The floor (2 cm, 0.3 deg) is added to each measured variance:
+  // x and y end near 2.0 and 2.2 cm, yaw near 0.32 deg, and what was unmeasured stays so.
+  RegistrationOptions o;
+  o.accuracy_m = 0.02;
+  o.accuracy_rad = 0.3 * M_PI / 180.0;
+  Matrix6 info = Matrix6::Zero();
+  info(0, 0) = 1.0 / (0.001 * 0.001);
+  info(1, 1) = 1.0 / (0.01 * 0.01);
+  const double yaw_sigma = 0.1 * M_PI / 180.0;
+  info(5, 5) = 1.0 / (yaw_sigma * yaw_sigma);
+  const Matrix6 floored = withAccuracyFloor(info, o);
+  EXPECT_NEAR(1.0 / std::sqrt(floored(0, 0)), std::hypot(0.001, 0.02), 1e-9);
+  EXPECT_NEAR(1.0 / std::sqrt(floored(1, 1)), std::hypot(0.01, 0.02), 1e-9);
+  EXPECT_NEAR(1.0 / std::sqrt(floored(5, 5)), std::hypot(yaw_sigma, o.accuracy_rad), 1e-9);
+  for (int k = 2; k < 5; ++k) EXPECT_EQ(floored(k, k), 0.0);
+  // A direction mixing x and y keeps its axes: the floor is isotropic in translation.
+  EXPECT_NEAR(floored(0, 1), 0.0, 1e-6);
 }

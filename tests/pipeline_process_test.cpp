@@ -164,7 +164,7 @@ TEST(PipelineProcess, FramesInFlightGiveStrictLockstepResults) {
   EXPECT_GT(scanBeforeSlot(overlap + "/run.lcmlog"), kFrames / 3);
 }
 
-TEST(PipelineProcess, ReplayedOdometryAndAssociationsGiveTheSameSlotState) {
+TEST(PipelineProcess, ReplayedBackendInputsGiveTheSameSlotState) {
   const std::string out = scratchDir();
   ChildProcess run(runArgs(out + "/run", {"--no-render", "--no-eval"}), out + "/run.log");
   ASSERT_EQ(run.wait(600), 0) << run.output();
@@ -175,7 +175,7 @@ TEST(PipelineProcess, ReplayedOdometryAndAssociationsGiveTheSameSlotState) {
   ChildProcess backend({bin("dlslot-backend"), "--config", config(), "--mode", "slot", "--key", out + "/run/run.key"},
                        out + "/backend.log");
   std::this_thread::sleep_for(std::chrono::seconds(1));
-  ChildProcess player({"/usr/bin/lcm-logplayer", "--speed=1", "--regexp=^(ODOMETRY|ASSOCIATIONS)$",
+  ChildProcess player({"/usr/bin/lcm-logplayer", "--speed=1", "--regexp=^(LIDAR_SCAN|ODOMETRY|ASSOCIATIONS)$",
                        out + "/run/run.lcmlog"},
                       out + "/logplayer.log");
   ASSERT_EQ(player.wait(120), 0) << player.output();

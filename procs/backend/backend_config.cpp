@@ -1,5 +1,6 @@
 #include "backend/backend_config.hpp"
 
+#include <cmath>
 #include <stdexcept>
 #include <vector>
 
@@ -112,6 +113,12 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   require(c.registration.min_points >= 6, s, "registration_min_points", "an integer >= 6");
   s.get("registration_information_scale", c.registration.information_scale);
   require(c.registration.information_scale > 0.0, s, "registration_information_scale", "a number > 0");
+  s.get("registration_accuracy_m", c.registration.accuracy_m);
+  require(c.registration.accuracy_m >= 0.0, s, "registration_accuracy_m", "a distance >= 0 (m)");
+  double accuracy_deg = c.registration.accuracy_rad * 180.0 / M_PI;
+  s.get("registration_accuracy_deg", accuracy_deg);
+  require(accuracy_deg >= 0.0, s, "registration_accuracy_deg", "an angle >= 0 (deg)");
+  c.registration.accuracy_rad = accuracy_deg * M_PI / 180.0;
   s.get("registration_max_sigma", c.registration.max_sigma);
   require(c.registration.max_sigma > 0.0, s, "registration_max_sigma", "a distance > 0 (m)");
   s.get("registration_model_frames", c.registration.model_frames);

@@ -44,7 +44,7 @@ void linearize(const Factor& f, const std::unordered_set<const double*>& fixed, 
   const auto* factor = dynamic_cast<const PoseFactor*>(f.cost.get());
   if (!factor) throw std::logic_error("linearize: expected a PoseFactor or a MarginalizationPrior");
   lin.J.resize(nb);
-  Matrix6* J[PoseFactor::kMaxBlocks] = {nullptr, nullptr, nullptr};
+  Matrix6* J[PoseFactor::kMaxBlocks] = {};
   for (int k = 0; k < nb; ++k) {
     if (lin.estimated[k]) {
       J[k] = &lin.J[k];

@@ -202,6 +202,24 @@ PreparedObject::Plane PreparedObject::fit(const Eigen::Vector3d& p, const Regist
   return Plane{true, es.eigenvectors().col(0)};
 }
 
+// Each measured direction v (an eigenvector of the centred information, translation and rotation
+// parts v_t, v_r) gets the accuracy floor's variance a^2 = |v_t|^2 accuracy_m^2 + |v_r|^2
+// accuracy_rad^2 added: lambda -> 1 / (1 / lambda + a^2). Unmeasured directions stay unmeasured.
+Matrix6 withAccuracyFloor(const Matrix6& info, const RegistrationOptions& o) {
+  Eigen::SelfAdjointEigenSolver<Matrix6> es(0.5 * (info + info.transpose()));
+  const double lambda_max = std::max(es.eigenvalues().maxCoeff(), 0.0);
+  Matrix6 out = Matrix6::Zero();
+  for (int k = 0; k < 6; ++k) {
+    const double lambda = es.eigenvalues()[k];
+    if (!(lambda > 1e-12 * lambda_max)) continue;
+    const Vector6 v = es.eigenvectors().col(k);
+    const double a2 = v.head<3>().squaredNorm() * o.accuracy_m * o.accuracy_m +
+                      v.tail<3>().squaredNorm() * o.accuracy_rad * o.accuracy_rad;
+    out += v * v.transpose() * (lambda / (1.0 + lambda * a2));
+  }
+  return out;
+}
+
 RegistrationResult registerObject(const ObjectPoints& previous, const ObjectPoints& current, const Pose& prediction,
                                   double range, const RegistrationOptions& o) {
   if (static_cast<int>(previous.size()) < o.min_points || static_cast<int>(current.size()) < o.min_points) {
@@ -368,7 +386,7 @@ RegistrationResult registerObject(const PreparedObject& previous, const Prepared
     result.outcome = RegistrationOutcome::kDegenerate;
     return result;
   }
-  info = P.transpose() * info * P;
+  info = withAccuracyFloor(P.transpose() * info * P, o);
   // Centred tangent -> world tangent at M: dt_c = dt_w - [R c]x dtheta_w, dtheta_c = dtheta_w.
   Matrix6 G = Matrix6::Identity();
   G.block<3, 3>(0, 3) = -skew(R * c);

@@ -58,6 +58,13 @@ struct RegistrationOptions {
   double converged_step = 1e-3;   // m (and rad x 1 m): the step that ends the iterations
   double point_sigma = 0.02;      // m: floor of the residuals' standard deviation (sensor noise)
   double information_scale = 0.1; // neighbouring points are correlated: the information times this
+  // What one registration is worth at best, whatever its point count: every scan's rings cross the
+  // object at other heights, so its error does not shrink as 1/sqrt(points) (simulated drives,
+  // fully measured cars with the true ego: 1.7 cm a frame, docs/object-motion.md). Added to the
+  // measured directions' variance; without it a registration of a near car claims millimetres, and
+  // under the graph's Cauchy loss a chain a few centimetres off then ignores it altogether.
+  double accuracy_m = 0.02;
+  double accuracy_rad = 0.005;
   // A horizontal direction whose marginal standard deviation exceeds this (m) is not measured.
   double max_sigma = 0.03;
   double min_inlier_fraction = 0.5;  // fewer previous points with a plane within max_residual: kPoorFit
@@ -68,6 +75,10 @@ struct RegistrationOptions {
   int model_frames = 5;
   int max_model_points = 1200;
 };
+
+// The information of a registration (any tangent with translation first) with the accuracy floor
+// of `o` added to each measured direction's variance.
+Matrix6 withAccuracyFloor(const Matrix6& information, const RegistrationOptions& o);
 
 enum class RegistrationOutcome {
   kMeasured,      // every direction measured (x, y and yaw when planar)

@@ -1,4 +1,4 @@
-// The base of every factor of eq. 8-11: a whitened SE(3) error r = S e over 2 or 3 pose blocks,
+// The base of every factor of eq. 8-11: a whitened SE(3) error r = S e over 1 to 4 pose blocks,
 // e = B^-1 A Z from relativeError with analytic tangent Jacobians. evaluate() gives r and the
 // tangent Jacobians the WindowSolver and Marginalizer use directly; Evaluate() turns them into
 // the ambient Jacobians Ceres wants (tests compare against Ceres' own solver with it).
@@ -12,7 +12,7 @@ namespace dlslot::backend {
 
 class PoseFactor : public ceres::CostFunction {
  public:
-  static constexpr int kMaxBlocks = 3;
+  static constexpr int kMaxBlocks = 4;
 
   PoseFactor(int num_blocks, const Matrix6& sqrt_info) : sqrt_info_(sqrt_info) {
     set_num_residuals(6);
@@ -22,7 +22,7 @@ class PoseFactor : public ceres::CostFunction {
   // r = S e, and J[k] = dr/d(tangent of block k) where J[k] is not null (J may be null).
   Vector6 evaluate(double const* const* x, Matrix6* const* J) const {
     Matrix6 d[kMaxBlocks];
-    Matrix6* dp[kMaxBlocks] = {nullptr, nullptr, nullptr};
+    Matrix6* dp[kMaxBlocks] = {};
     const int n = static_cast<int>(parameter_block_sizes().size());
     for (int k = 0; k < n; ++k)
       if (J && J[k]) dp[k] = &d[k];
@@ -34,7 +34,7 @@ class PoseFactor : public ceres::CostFunction {
 
   bool Evaluate(double const* const* x, double* residuals, double** jacobians) const final {
     Matrix6 J[kMaxBlocks];
-    Matrix6* Jp[kMaxBlocks] = {nullptr, nullptr, nullptr};
+    Matrix6* Jp[kMaxBlocks] = {};
     const int n = static_cast<int>(parameter_block_sizes().size());
     for (int k = 0; k < n; ++k)
       if (jacobians && jacobians[k]) Jp[k] = &J[k];

@@ -1,35 +1,50 @@
 // A measured pose change (not in the paper's graph, which has only box observations): the
-// object's own points registered between two scans (object_registration.hpp) measure its
-// pose-change vertex c_{t-1}^t of eq. 10 directly. e = c_meas^-1 c, the form B^-1 A Z with
-// A = c, B = c_meas (constant), Z = I; the square-root information comes from the registration's
-// (rank-deficient where a direction was not measured).
+// object's own points registered between two scans (object_registration.hpp) measure how it
+// moved relative to the sensor, A = b_t b_{t-1}^-1 (b: its pose in the lidar frame). With the
+// ego poses and eq. 10 (o_t = o_{t-1} c):
+//   A = X_t^-1 o_{t-1} c o_{t-1}^-1 X_{t-1},   e = A_meas^-1 A,
+// on the blocks X_{t-1}, X_t, o_{t-1} and the pose-change vertex c. The ego poses are in the
+// factor, not in the measurement: the registration runs in the world frame of the ego estimates
+// of its time, and a measurement carried there with them would bring the odometry's motion into
+// the window once more for every registered object, holding the ego where the odometry put it.
 #pragma once
 
 #include "backend/pose_factor.hpp"
 
 namespace dlslot::backend {
 
-class PoseChangeMeasurementFactor final : public PoseFactor {
+class RegistrationFactor final : public PoseFactor {
  public:
-  PoseChangeMeasurementFactor(const Pose& c_meas, const Matrix6& sqrt_info) : PoseFactor(1, sqrt_info), c_meas_(c_meas) {}
-  static ceres::CostFunction* Create(const Pose& c_meas, const Matrix6& sqrt_info) {
-    return new PoseChangeMeasurementFactor(c_meas, sqrt_info);
+  // A_meas and the square-root information of e (registrationMeasurement).
+  RegistrationFactor(const Pose& A_meas, const Matrix6& sqrt_info) : PoseFactor(4, sqrt_info), A_meas_(A_meas) {}
+  static ceres::CostFunction* Create(const Pose& A_meas, const Matrix6& sqrt_info) {
+    return new RegistrationFactor(A_meas, sqrt_info);
   }
 
  protected:
-  // Parameter: c_{t-1}^t.
-  Vector6 error(double const* const* x, Matrix6* const* d) const override {
-    return relativeError(fromBlock(x[0]), c_meas_, Pose::Identity(), d[0], nullptr, nullptr);
-  }
+  // Parameters: X_{t-1}, X_t, o_{t-1}, c. e = B^-1 M Z with B = X_t A_meas, M = o c o^-1 (the
+  // object's motion in the world) and Z = X_{t-1}; each block's left perturbation carried into
+  // those of B and M.
+  Vector6 error(double const* const* x, Matrix6* const* d) const override;
 
  private:
-  Pose c_meas_;
+  Pose A_meas_;
 };
 
-// The registration's world-frame motion M (o_t = M o_{t-1}) as a pose-change measurement of an
-// object at o_prev: c_meas = o_prev^-1 M o_prev, and the square-root information of
-// e = c_meas^-1 c from M's information (world tangent at M) through the numeric Jacobian of e
-// with respect to M's tangent.
+// A registration's world-frame motion M (o_t = M o_{t-1}), found with the object's points put
+// into the world by the ego poses X_prev (its previous points) and X_cur (its current ones), as
+// the factor's measurement A_meas = X_cur^-1 M X_prev with the square-root information of e
+// from M's information (world tangent at M; rank-deficient where a direction was not measured).
+struct RegistrationMeasurement {
+  Pose A_meas = Pose::Identity();
+  Matrix6 sqrt_info = Matrix6::Zero();
+};
+RegistrationMeasurement registrationMeasurement(const Pose& M, const Matrix6& information, const Pose& X_prev,
+                                                const Pose& X_cur);
+
+// The same M as the change of a frame at o_prev: c_meas = o_prev^-1 M o_prev, with the
+// square-root information of c_meas^-1 c (registered_velocity.hpp reads a centre's displacement
+// from it).
 struct PoseChangeMeasurement {
   Pose c_meas = Pose::Identity();
   Matrix6 sqrt_info = Matrix6::Zero();

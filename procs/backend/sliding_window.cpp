@@ -278,6 +278,7 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
   std::optional<Pose> measured;
   const auto keep = [&] {
     track.points_frame = frame;
+    track.points_ego = X;
     track.accumulated.update(world, frame, measured, range, options);  // also the refined box's points
     if (!with_model) {
       track.points = current;
@@ -309,7 +310,7 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
   ++out.registrations[static_cast<int>(r.outcome)];
   out.registration_points += r.source_points;
   if (r.ok()) out.registration_residual_sq += r.rms_residual * r.rms_residual;
-  if (r.ok()) track.motions[frame] = Track::Motion{r.motion, r.information};
+  if (r.ok()) track.motions[frame] = Track::Motion{r.motion, r.information, track.points_ego, X};
   // Only a full measurement carries the model along: a partial one's unmeasured direction is the
   // prediction's (decimetres off), and older points moved by it would smear the model along the
   // face it could not see.
@@ -437,11 +438,15 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
     double* change = newBlock(track.changes[f - 1], fromBlock(prev).inverse() * o_f);  // eq. 2
     addFactor(PoseChangeFactor::Create(sqrtInformation(config_.pose_change_sigma)), false, {prev, cur, change});
     if (isVehicle(track.type)) addFactor(VehicleMotionFactor::Create(config_.vehicle_motion_sigma), false, {change});
-    // The object's points measured this pose change (robust: a wrong association registers two
-    // objects' points).
-    if (const auto m = track.motions.find(f); m != track.motions.end()) {
-      const PoseChangeMeasurement pm = poseChangeMeasurement(m->second.M, m->second.information, fromBlock(prev));
-      addFactor(PoseChangeMeasurementFactor::Create(pm.c_meas, pm.sqrt_info), true, {change});
+    // The object's points measured how it moved against the sensor between f - 1 and f (robust: a
+    // wrong association registers two objects' points).
+    const auto m = track.motions.find(f);
+    const EgoFrame *ego_prev = findFrame(f - 1), *ego_cur = findFrame(f);
+    if (m != track.motions.end() && ego_prev && ego_cur) {
+      const RegistrationMeasurement rm =
+          registrationMeasurement(m->second.M, m->second.information, m->second.X_prev, m->second.X_cur);
+      addFactor(RegistrationFactor::Create(rm.A_meas, rm.sqrt_info), true,
+                {ego_prev->pose->data(), ego_cur->pose->data(), prev, change});
     }
     auto before = track.changes.find(f - 2);
     if (before != track.changes.end())

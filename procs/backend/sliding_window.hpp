@@ -80,13 +80,16 @@ class SlidingWindow {
     // Per-object registration: the object's accumulated points (its model, world frame of its
     // latest scan) and the same prepared as the next frame's source (the latest scan alone when
     // registration_model_frames is 1), and the motions measured between consecutive scans
-    // (frame t -> M of t-1 -> t, world frame).
+    // (frame t -> M of t-1 -> t, world frame), each with the ego poses that put the two scans'
+    // points into the world (points_ego: those of the kept points).
     ObjectModel accumulated;
     std::shared_ptr<const PreparedObject> points;
     int points_frame = -1;
+    Pose points_ego = Pose::Identity();
     struct Motion {
       Pose M = Pose::Identity();
       Matrix6 information = Matrix6::Zero();
+      Pose X_prev = Pose::Identity(), X_cur = Pose::Identity();
     };
     std::map<int, Motion> motions;
     Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();

@@ -20,15 +20,12 @@ void attachObjectPoints(const PointCloud& scan, const BackendConfig& config, std
     owner.push_back(static_cast<int>(i));
   }
   if (volumes.empty()) return;
-  // The grid-accelerated mask first (most points are in no box), then each object point's boxes.
-  const std::vector<bool> inside = pointsInBoxes(scan, volumes, 0.0);
+  const std::vector<std::vector<int>> members = pointsOfBoxes(scan, volumes, 0.0);
   std::vector<std::shared_ptr<ObjectPoints>> points(volumes.size());
-  for (auto& p : points) p = std::make_shared<ObjectPoints>();
-  for (Eigen::Index i = 0; i < scan.cols(); ++i) {
-    if (!inside[i]) continue;
-    const Eigen::Vector3d p = scan.col(i).head<3>().cast<double>();
-    for (size_t b = 0; b < volumes.size(); ++b)
-      if (volumes[b].contains(p)) points[b]->push_back(p.cast<float>());
+  for (size_t b = 0; b < volumes.size(); ++b) {
+    points[b] = std::make_shared<ObjectPoints>();
+    points[b]->reserve(members[b].size());
+    for (int i : members[b]) points[b]->push_back(scan.col(i).head<3>());
   }
   for (size_t b = 0; b < volumes.size(); ++b) observations[owner[b]].points = std::move(points[b]);
 }

@@ -11,6 +11,10 @@ namespace dlslot {
 // mask[i] is true when point i lies inside any box grown by `margin` metres on every side.
 std::vector<bool> pointsInBoxes(const PointCloud& scan, const std::vector<Box>& boxes, double margin);
 
+// The indices of the points inside each box grown by `margin` (a point in overlapping boxes is in
+// each of them), in scan order.
+std::vector<std::vector<int>> pointsOfBoxes(const PointCloud& scan, const std::vector<Box>& boxes, double margin);
+
 // The volume A-LOAM* removes for a detected object: the box grown by `margin` on every side but
 // the bottom, which is raised to `ground_clearance` above the box's floor. The margin absorbs the
 // detector's position and size errors; growing the box downwards too cut out the ground around

@@ -185,7 +185,7 @@ TEST(ObjectRegistration, OutcomesHaveNames) {
 
 // ---- a world motion as a pose change (registered_velocity.hpp reads it) ----
 
-TEST(PoseChangeMeasurement, WorldMotionBecomesTheObjectsPoseChange) {
+TEST(RegistrationMeasurement, WorldMotionBecomesTheObjectsPoseChange) {
   // An object at o_prev moving by c in its own frame moves the world by M = o_prev c o_prev^-1;
   // the measurement of M gives back c, and information along world x (the only measured
   // direction) becomes information along the object's heading, turned by its yaw.
@@ -194,8 +194,8 @@ TEST(PoseChangeMeasurement, WorldMotionBecomesTheObjectsPoseChange) {
   const Pose M = o_prev * c * o_prev.inverse();
   Matrix6 info = Matrix6::Zero();
   info(1, 1) = 1e4;  // world y: the object's heading
-  const PoseChangeMeasurement pm = poseChangeMeasurement(M, info, o_prev);
-  EXPECT_LT(logPose(pm.c_meas.inverse() * c).norm(), 1e-9);
+  const RegistrationMeasurement pm = registrationMeasurement(M, info, o_prev, o_prev);
+  EXPECT_LT(logPose(pm.A_meas.inverse() * c).norm(), 1e-9);
   const Matrix6 info_c = pm.sqrt_info.transpose() * pm.sqrt_info;
   EXPECT_NEAR(info_c(0, 0), 1e4, 50.0);  // along the heading: measured
   EXPECT_LT(std::abs(info_c(1, 1)), 1.0);   // across it: not

@@ -64,7 +64,7 @@ struct RegistrationOptions {
   // measured directions' variance; without it a registration of a near car claims millimetres, and
   // under the graph's Cauchy loss a chain a few centimetres off then ignores it altogether.
   double accuracy_m = 0.02;
-  double accuracy_rad = 0.005;
+  double accuracy_rad = 0.0052359877559829887;  // 0.3 deg
   // A horizontal direction whose marginal standard deviation exceeds this (m) is not measured.
   double max_sigma = 0.03;
   double min_inlier_fraction = 0.5;  // fewer previous points with a plane within max_residual: kPoorFit

@@ -14,7 +14,7 @@ std::optional<VelocityEvidence> registeredVelocity(const Pose& M, const Matrix6&
   // translation is the centre's displacement, in world axes.
   Pose o = Pose::Identity();
   o.translation() = p_prev;
-  const PoseChangeMeasurement pm = poseChangeMeasurement(M, information, o);
+  const RegistrationMeasurement pm = registrationMeasurement(M, information, o, o);
   const Matrix6 info = pm.sqrt_info.transpose() * pm.sqrt_info;
   // The registration measures the ground plane only (x, y, yaw): the yaw marginalized (Schur
   // complement) out of that block. Height, roll and pitch carry no information; their
@@ -24,7 +24,7 @@ std::optional<VelocityEvidence> registeredVelocity(const Pose& M, const Matrix6&
   if (yy > 0) tt -= info.block<2, 1>(0, 5) * info.block<1, 2>(5, 0) / yy;
   // Bird's-eye displacement information, each measured direction's variance grown by the ego's.
   // e's translation is in the measured change's axes (turned by its yaw): back to the world's.
-  const Eigen::Matrix2d R = pm.c_meas.linear().topLeftCorner<2, 2>();
+  const Eigen::Matrix2d R = pm.A_meas.linear().topLeftCorner<2, 2>();
   tt = R * tt * R.transpose();
   Eigen::Matrix2d d_info = 0.5 * (tt + tt.transpose());
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> ed(d_info);

@@ -7,20 +7,6 @@ namespace dlslot::backend {
 
 namespace {
 
-// S with S^T S = info (info may be rank-deficient): sqrt(Lambda) V^T.
-Matrix6 sqrtOfInformation(Matrix6 info) {
-  info = 0.5 * (info + info.transpose());
-  Eigen::SelfAdjointEigenSolver<Matrix6> es(info);
-  const Vector6 lambda = es.eigenvalues().cwiseMax(0.0);
-  return lambda.cwiseSqrt().asDiagonal() * es.eigenvectors().transpose();
-}
-
-// Info_e = G^-T Info_M G^-1 for e's Jacobian G with respect to M's tangent (invertible here).
-Matrix6 carried(const Matrix6& information, const Matrix6& G) {
-  const Matrix6 Gi = G.inverse();
-  return sqrtOfInformation(Gi.transpose() * information * Gi);
-}
-
 // [[I, -[t]x], [0, I]]: a left perturbation of P carried to that of P Q (t = R_P t_Q).
 Matrix6 leftOfProduct(const Eigen::Vector3d& t) {
   Matrix6 T = Matrix6::Identity();
@@ -68,17 +54,12 @@ RegistrationMeasurement registrationMeasurement(const Pose& M, const Matrix6& in
   // e = (X_cur A_meas)^-1 M' X_prev, whose Jacobian in M' at M is relativeError's dA.
   Matrix6 G;
   relativeError(M, X_cur * out.A_meas, X_prev, &G, nullptr, nullptr);
-  out.sqrt_info = carried(information, G);
-  return out;
-}
-
-PoseChangeMeasurement poseChangeMeasurement(const Pose& M, const Matrix6& information, const Pose& o_prev) {
-  PoseChangeMeasurement out;
-  out.c_meas = o_prev.inverse() * M * o_prev;
-  // e = c_meas^-1 o^-1 M' o = (o c_meas)^-1 M' o, whose Jacobian in M' is relativeError's dA.
-  Matrix6 G;
-  relativeError(M, o_prev * out.c_meas, o_prev, &G, nullptr, nullptr);
-  out.sqrt_info = carried(information, G);
+  // Info_e = G^-T Info_M G^-1 (G is invertible: conjugations and a left Jacobian), and
+  // S = sqrt(Lambda) V^T with S^T S = Info_e (rank-deficient where M was not measured).
+  const Matrix6 Gi = G.inverse();
+  const Matrix6 info = Gi.transpose() * information * Gi;
+  Eigen::SelfAdjointEigenSolver<Matrix6> es(0.5 * (info + info.transpose()));
+  out.sqrt_info = es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal() * es.eigenvectors().transpose();
   return out;
 }
 

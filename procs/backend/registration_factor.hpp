@@ -35,20 +35,13 @@ class RegistrationFactor final : public PoseFactor {
 // into the world by the ego poses X_prev (its previous points) and X_cur (its current ones), as
 // the factor's measurement A_meas = X_cur^-1 M X_prev with the square-root information of e
 // from M's information (world tangent at M; rank-deficient where a direction was not measured).
+// With X_prev = X_cur = o it is M as the pose change of a frame at o, o^-1 M o
+// (registered_velocity.hpp reads a centre's displacement from it).
 struct RegistrationMeasurement {
   Pose A_meas = Pose::Identity();
   Matrix6 sqrt_info = Matrix6::Zero();
 };
 RegistrationMeasurement registrationMeasurement(const Pose& M, const Matrix6& information, const Pose& X_prev,
                                                 const Pose& X_cur);
-
-// The same M as the change of a frame at o_prev: c_meas = o_prev^-1 M o_prev, with the
-// square-root information of c_meas^-1 c (registered_velocity.hpp reads a centre's displacement
-// from it).
-struct PoseChangeMeasurement {
-  Pose c_meas = Pose::Identity();
-  Matrix6 sqrt_info = Matrix6::Zero();
-};
-PoseChangeMeasurement poseChangeMeasurement(const Pose& M, const Matrix6& information, const Pose& o_prev);
 
 }  // namespace dlslot::backend

@@ -1,6 +1,7 @@
-// dlslot-bench-check: judges one pipeline run's CPU per frame (dlslot-run's OUT/speed.yaml)
-// against the stored figures of a case in bench/baseline.yaml, or records it there.
-//   dlslot-bench-check --baseline bench/baseline.yaml --case NAME --measured OUT/speed.yaml
+// dlslot-bench-check: judges the CPU per frame of one or more runs of a pipeline case (dlslot-run's
+// OUT/speed.yaml; each process's median over the runs) against the stored figures of the case in
+// bench/baseline.yaml, or records it there.
+//   dlslot-bench-check --baseline bench/baseline.yaml --case NAME --measured OUT1/speed.yaml [--measured OUT2/speed.yaml ...]
 //   dlslot-bench-check ... --record "why the cost changed"
 // Exit 0: every process within 15 % of its stored cost; 1: some process over (named on stderr
 // and in the last line); 2: bad arguments or files.
@@ -33,19 +34,22 @@ std::string utcNow() {
 }
 
 int check(int argc, char** argv) {
-  std::string baseline, name, measured_path, reason;
+  std::string baseline, name, reason;
+  std::vector<std::string> measured_paths;
   double tolerance = 0.15;
   CommandLine cl("dlslot-bench-check",
                  "Compares a pipeline run's CPU per frame (dlslot-run's OUT/speed.yaml) with bench/baseline.yaml.");
   cl.option("--baseline", &baseline, "the stored figures (bench/baseline.yaml)");
   cl.option("--case", &name, "which run, e.g. highway-150-lockstep-no-render");
-  cl.option("--measured", &measured_path, "dlslot-run's OUT/speed.yaml");
+  cl.repeated("--measured", &measured_paths, "dlslot-run's OUT/speed.yaml (repeated: each process's median over the runs)");
   cl.option("--tolerance", &tolerance, "allowed growth of a process's CPU per frame (default 0.15)");
   cl.option("--record", &reason, "store the measured figures as the case's new baseline, with this reason");
   if (!cl.parse(argc, argv)) return 0;
-  if (baseline.empty() || name.empty() || measured_path.empty())
+  if (baseline.empty() || name.empty() || measured_paths.empty())
     throw std::invalid_argument("--baseline, --case and --measured are required");
-  const run::SpeedFigures measured = run::speedFromYaml(loadFile(measured_path), measured_path);
+  std::vector<run::SpeedFigures> runs;
+  for (const std::string& path : measured_paths) runs.push_back(run::speedFromYaml(loadFile(path), path));
+  const run::SpeedFigures measured = run::medianOf(runs);
 
   if (!reason.empty()) {
     YAML::Node all = std::ifstream(baseline) ? loadFile(baseline) : YAML::Node(YAML::NodeType::Map);

@@ -1,5 +1,6 @@
 #include "speed_guard.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -34,6 +35,31 @@ SpeedFigures speedFromYaml(const YAML::Node& node, const std::string& where) {
   if (const YAML::Node load = node["load"]; load && load.IsSequence())
     for (size_t i = 0; i < load.size(); ++i) f.load.push_back(load[i].as<double>());
   return f;
+}
+
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+SpeedFigures medianOf(const std::vector<SpeedFigures>& runs) {
+  SpeedFigures out;
+  if (runs.empty()) return out;
+  std::map<std::string, std::vector<double>> cpu;
+  std::vector<double> rates;
+  for (const SpeedFigures& r : runs) {
+    for (const auto& [p, ms] : r.cpu_ms) cpu[p].push_back(ms);
+    rates.push_back(r.rate_fps);
+  }
+  for (auto& [p, v] : cpu) out.cpu_ms[p] = median(v);
+  out.rate_fps = median(rates);
+  out.load = runs.front().load;
+  return out;
 }
 
 SpeedVerdict compareSpeed(const SpeedFigures& stored, const SpeedFigures& measured, double tolerance,

@@ -22,6 +22,13 @@ struct SpeedFigures {
 // (std::invalid_argument: "FILE: KEY: expected ...").
 SpeedFigures speedFromYaml(const YAML::Node& node, const std::string& where);
 
+// Each process's median CPU per frame over several runs of the same case (and the median rate;
+// the load of the first run): a process's CPU per frame moves 10-30 % from run to run on the
+// shared machine (the player 2.6-3.2 ms, the mapper beside the renderer 3.4-4.9 ms, in 8-10
+// alternating rounds), as much as the guard's tolerance, so one run is not a figure. A process
+// missing from a run counts over the runs that have it.
+SpeedFigures medianOf(const std::vector<SpeedFigures>& runs);
+
 struct SpeedVerdict {
   std::vector<std::string> over;  // processes over their limit
   std::string report;             // one line per process: measured, stored, change, limit

@@ -218,6 +218,11 @@ TEST(ObjectRegistration, NoRegistrationClaimsMoreThanItsAccuracy) {
   EXPECT_NEAR(1.0 / std::sqrt(floored(1, 1)), std::hypot(0.01, 0.02), 1e-9);
   EXPECT_NEAR(1.0 / std::sqrt(floored(5, 5)), std::hypot(yaw_sigma, o.accuracy_rad), 1e-9);
   for (int k = 2; k < 5; ++k) EXPECT_EQ(floored(k, k), 0.0);
-  // A direction mixing x and y keeps its axes: the floor is isotropic in translation.
-  EXPECT_NEAR(floored(0, 1), 0.0, 1e-6);
+  // The same information about axes turned 30 deg in the ground plane: the floor is isotropic in
+  // translation, so the floored information is the turned floored one (directions keep their axes).
+  Matrix6 T = Matrix6::Identity();
+  T.topLeftCorner<3, 3>() = Eigen::AngleAxisd(M_PI / 6, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Matrix6 turned = withAccuracyFloor(T * info * T.transpose(), o);
+  EXPECT_LT((turned - T * floored * T.transpose()).norm(), 1e-6 * floored.norm());
+  EXPECT_GT(std::abs(turned(0, 1)), 100.0);  // x and y mixed: not a diagonal case
 }

@@ -7,23 +7,6 @@ namespace dlslot {
 
 namespace {
 
-// A grown box's containment test with its yaw's cosine and sine taken once: Box::contains takes
-// them per call, and with a few thousand object points against a few dozen boxes a frame that
-// sincos was 15 % of the backend's time.
-struct BoxTest {
-  double x, y, z, c, s, hx, hy, hz;
-  double r2;  // squared radius of its bounding circle (the cheap test first)
-  BoxTest(const Box& b, double margin)
-      : x(b.center.x()), y(b.center.y()), z(b.center.z()), c(std::cos(b.yaw)), s(std::sin(b.yaw)),
-        hx(0.5 * b.size.x() + margin), hy(0.5 * b.size.y() + margin), hz(0.5 * b.size.z() + margin),
-        r2(hx * hx + hy * hy) {}
-  bool contains(double px, double py, double pz) const {
-    const double dx = px - x, dy = py - y;
-    if (dx * dx + dy * dy > r2) return false;  // most points are far from any box
-    return std::abs(c * dx + s * dy) <= hx && std::abs(-s * dx + c * dy) <= hy && std::abs(pz - z) <= hz;
-  }
-};
-
 // Calls visit(i, b) for each point i inside grown box b; visit returns true when the point needs
 // no further box. Each box's bounding circle is entered into the cells of a coarse horizontal
 // grid over the boxes, and a point meets only the boxes of its cell (most cells and points: none).
@@ -33,7 +16,7 @@ template <class Visit>
 void visitPointsInBoxes(const PointCloud& scan, const std::vector<Box>& boxes, double margin, Visit&& visit) {
   if (boxes.empty()) return;
   const double cell = 2.0;
-  std::vector<BoxTest> tests;
+  std::vector<BoxContainment> tests;
   tests.reserve(boxes.size());
   double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
   for (const Box& b : boxes) {
@@ -55,14 +38,14 @@ void visitPointsInBoxes(const PointCloud& scan, const std::vector<Box>& boxes, d
   }
   // Cell c holds the boxes members[start[c] .. start[c + 1]).
   std::vector<int> start(nx * ny + 1, 0), members;
-  auto cellsOf = [&](const BoxTest& t, auto&& each) {
+  auto cellsOf = [&](const BoxContainment& t, auto&& each) {
     const double r = std::sqrt(t.r2);
     const long cx0 = static_cast<long>(std::floor((t.x - r - x0) / cell)), cx1 = static_cast<long>(std::floor((t.x + r - x0) / cell));
     const long cy0 = static_cast<long>(std::floor((t.y - r - y0) / cell)), cy1 = static_cast<long>(std::floor((t.y + r - y0) / cell));
     for (long cy = std::max(0L, cy0); cy <= std::min(ny - 1, cy1); ++cy)
       for (long cx = std::max(0L, cx0); cx <= std::min(nx - 1, cx1); ++cx) each(cy * nx + cx);
   };
-  for (const BoxTest& t : tests) cellsOf(t, [&](long k) { ++start[k + 1]; });
+  for (const BoxContainment& t : tests) cellsOf(t, [&](long k) { ++start[k + 1]; });
   for (size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
   members.resize(start.back());
   std::vector<int> next(start.begin(), start.end() - 1);

@@ -19,13 +19,13 @@ Box Box::transformed(const Pose& T_new_frame) const {
   return out;
 }
 
+BoxContainment::BoxContainment(const Box& b, double margin)
+    : x(b.center.x()), y(b.center.y()), z(b.center.z()), c(std::cos(b.yaw)), s(std::sin(b.yaw)),
+      hx(0.5 * b.size.x() + margin), hy(0.5 * b.size.y() + margin), hz(0.5 * b.size.z() + margin),
+      r2(hx * hx + hy * hy) {}
+
 bool Box::contains(const Eigen::Vector3d& p, double margin) const {
-  const Eigen::Vector3d d = p - center;
-  const double c = std::cos(yaw), s = std::sin(yaw);
-  const double along = c * d.x() + s * d.y();
-  const double across = -s * d.x() + c * d.y();
-  return std::abs(along) <= 0.5 * size.x() + margin && std::abs(across) <= 0.5 * size.y() + margin &&
-         std::abs(d.z()) <= 0.5 * size.z() + margin;
+  return BoxContainment(*this, margin).contains(p.x(), p.y(), p.z());
 }
 
 double yawOf(const Eigen::Matrix3d& R) { return std::atan2(R(1, 0), R(0, 0)); }

@@ -21,13 +21,12 @@ void attachObjectPoints(const PointCloud& scan, const BackendConfig& config, std
   }
   if (volumes.empty()) return;
   const std::vector<std::vector<int>> members = pointsOfBoxes(scan, volumes, 0.0);
-  std::vector<std::shared_ptr<ObjectPoints>> points(volumes.size());
   for (size_t b = 0; b < volumes.size(); ++b) {
-    points[b] = std::make_shared<ObjectPoints>();
-    points[b]->reserve(members[b].size());
-    for (int i : members[b]) points[b]->push_back(scan.col(i).head<3>());
+    auto points = std::make_shared<ObjectPoints>();
+    points->reserve(members[b].size());
+    for (int i : members[b]) points->push_back(scan.col(i).head<3>());
+    observations[owner[b]].points = std::move(points);
   }
-  for (size_t b = 0; b < volumes.size(); ++b) observations[owner[b]].points = std::move(points[b]);
 }
 
 }  // namespace dlslot::backend

@@ -129,6 +129,8 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   s.get("registration_refine_boxes", c.registration_refine_boxes);
   s.get("registration_box_margin", c.registration_box_margin);
   require(c.registration_box_margin >= 0.0, s, "registration_box_margin", "a distance >= 0 (m)");
+  s.get("registration_box_margin_sigmas", c.registration_box_margin_sigmas);
+  require(c.registration_box_margin_sigmas >= 0.0, s, "registration_box_margin_sigmas", "a number >= 0 (standard deviations)");
   s.get("registration_ground_clearance", c.registration_ground_clearance);
   require(c.registration_ground_clearance >= 0.0, s, "registration_ground_clearance", "a distance >= 0 (m)");
   s.get("solver_threads", c.solver_threads);

@@ -49,6 +49,8 @@ struct BackendConfig {
   // translation sigmas of (landmark) observations are the ones above times (1 + this x range in
   // m); 0 keeps them constant.
   double observation_sigma_growth_per_m = 0.0;
+  // Factor by which a box's translation sigmas grow at this range.
+  double observationNoiseGrowth(double range_m) const { return 1.0 + observation_sigma_growth_per_m * range_m; }
   // Odometry sigmas are multiplied by this when the odometry fell back to a prediction or
   // did not arrive (then the pose is predicted with constant velocity).
   double degraded_odometry_scale = 10.0;
@@ -67,9 +69,14 @@ struct BackendConfig {
   // dozen points on a body that changes shape as it walks.
   std::vector<std::string> registration_types;
   RegistrationOptions registration;
-  // The points taken for an object (the node's selection): its box grown by this margin (m) on
-  // every side but the bottom, which is raised this far above the box's floor (the ground).
+  // The points taken for an object (the node's selection): its box grown by a margin on every
+  // side but the bottom, which is raised registration_ground_clearance above the box's floor (the
+  // ground). The margin is this (m), or this many standard deviations of the box's position along
+  // its length at its range (observation_sigma x observationNoiseGrowth) when that is more: the
+  // faces a scan shows lie on the box's edges, and a far box's error (0.4 m at 100 m) put a
+  // truck's front face outside a 0.2 m margin in every other scan.
   double registration_box_margin = 0.2;
+  double registration_box_margin_sigmas = 2.0;
   // The scans' firing order, from the config's lidar section (LidarConfig): a registered object's
   // points are moved to the scan's reference instant (its pose's, its boxes') by the ego's motion
   // and the object's over the time from their firing. period 0: de-skewed scans.

@@ -14,7 +14,9 @@ void attachObjectPoints(const PointCloud& scan, const BackendConfig& config, std
     if (std::find(config.registration_types.begin(), config.registration_types.end(), o.box.type) ==
         config.registration_types.end())
       continue;
-    const Box v = removalVolume(o.box, config.registration_box_margin, config.registration_ground_clearance);
+    const double sigma = config.observation_sigma[0] * config.observationNoiseGrowth(o.box.center.norm());
+    const double margin = std::max(config.registration_box_margin, config.registration_box_margin_sigmas * sigma);
+    const Box v = removalVolume(o.box, margin, config.registration_ground_clearance);
     if (v.size.z() <= 0.0) continue;
     volumes.push_back(v);
     owner.push_back(static_cast<int>(i));

@@ -140,8 +140,6 @@ class SlidingWindow {
   double* newBlock(Block& slot, const Pose& value);
   const EgoFrame* findFrame(int frame) const;
   bool isVehicle(const std::string& type) const;
-  // Factor by which a box's translation sigmas grow at this range (observation_sigma_growth_per_m).
-  double noiseGrowth(double range_m) const;
   Pose alignedBox(const Track& track, const Pose& X, const Box& box) const;
   std::optional<Pose> predictedPose(const Track& track) const;
   std::vector<double*> liveBlocks() const;

@@ -131,6 +131,15 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   require(c.registration_box_margin >= 0.0, s, "registration_box_margin", "a distance >= 0 (m)");
   s.get("registration_box_margin_sigmas", c.registration_box_margin_sigmas);
   require(c.registration_box_margin_sigmas >= 0.0, s, "registration_box_margin_sigmas", "a number >= 0 (standard deviations)");
+  s.get("line_of_sight_min_points", c.line_of_sight_min_points);
+  require(c.line_of_sight_min_points >= 1, s, "line_of_sight_min_points", "an integer >= 1");
+  s.get("line_of_sight_max_angle_deg", c.line_of_sight_max_angle_deg);
+  require(c.line_of_sight_max_angle_deg >= 0.0 && c.line_of_sight_max_angle_deg <= 90.0, s, "line_of_sight_max_angle_deg",
+          "an angle in [0, 90] (deg)");
+  s.get("line_of_sight_pairs", c.line_of_sight_pairs);
+  require(c.line_of_sight_pairs >= 0, s, "line_of_sight_pairs", "an integer >= 0 (0: not used)");
+  s.get("line_of_sight_sigma", c.line_of_sight_sigma);
+  require(c.line_of_sight_sigma > 0.0, s, "line_of_sight_sigma", "a speed > 0 (m/s)");
   s.get("registration_ground_clearance", c.registration_ground_clearance);
   require(c.registration_ground_clearance >= 0.0, s, "registration_ground_clearance", "a distance >= 0 (m)");
   s.get("solver_threads", c.solver_threads);

@@ -96,6 +96,9 @@ struct BackendOutput {
   // point-to-plane residual, summed (to compare the simulator's objects with real ones).
   int64_t registration_points = 0;
   double registration_residual_sq = 0;
+  // Scan pairs of this frame whose face's speed along the line of sight was measured
+  // (line_of_sight.hpp).
+  int line_of_sight_pairs = 0;
 };
 
 }  // namespace dlslot::backend

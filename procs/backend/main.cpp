@@ -96,6 +96,7 @@ void report(ProcessStatus& status, const BackendOutput& out) {
     if (out.registrations[k])
       status.count(std::string("registration_") + toString(static_cast<RegistrationOutcome>(k)), out.registrations[k]);
   if (out.registration_no_previous) status.count("registration_no_previous", out.registration_no_previous);
+  if (out.line_of_sight_pairs) status.count("line_of_sight_pairs", out.line_of_sight_pairs);
   // The odometry factor's test (odometry_consistency.hpp): frames tested, and those where the
   // landmarks and objects disagreed with it beyond both covariances (down-weighted or reported).
   const OdometryCheck& c = out.odometry_check;
@@ -167,7 +168,7 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   int frames = 0, missing_odometry = 0, missing_associations = 0;
   int64_t landmarks = 0, moving = 0, switched = 0;  // summed over frames
   std::array<int64_t, kNumRegistrationOutcomes> registrations{};
-  int64_t registration_no_previous = 0, registration_points = 0;
+  int64_t registration_no_previous = 0, registration_points = 0, line_of_sight_pairs = 0;
   double registration_residual_sq = 0;
   int odometry_tested = 0, odometry_disagreed = 0, odometry_downweighted = 0;
   double odometry_max_disagreement_m = 0;
@@ -190,6 +191,7 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
     registration_no_previous += result.registration_no_previous;
     registration_points += result.registration_points;
     registration_residual_sq += result.registration_residual_sq;
+    line_of_sight_pairs += result.line_of_sight_pairs;
     const OdometryCheck& check = result.odometry_check;
     odometry_tested += check.outcome != OdometryCheckOutcome::kUntested;
     if (check.outcome != OdometryCheckOutcome::kUntested) odometry_chi2.push_back(check.chi2);
@@ -256,7 +258,8 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   std::printf("  per-object registrations:");
   for (int k = 0; k < kNumRegistrationOutcomes; ++k)
     std::printf(" %s %lld", toString(static_cast<RegistrationOutcome>(k)), static_cast<long long>(registrations[k]));
-  std::printf(", no previous scan %lld\n", static_cast<long long>(registration_no_previous));
+  std::printf(", no previous scan %lld; line-of-sight pairs %lld\n", static_cast<long long>(registration_no_previous),
+              static_cast<long long>(line_of_sight_pairs));
   std::sort(odometry_chi2.begin(), odometry_chi2.end());
   const auto chi2At = [&](double q) {
     return odometry_chi2.empty() ? 0.0 : odometry_chi2[static_cast<size_t>(q * (odometry_chi2.size() - 1))];

@@ -270,6 +270,7 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
     p += t * (ego.angular.cross(p) + ego.velocity - v_obj);
     world.push_back((X * p).cast<float>());
   }
+  out.line_of_sight_pairs += measureLineOfSight(track, world, obs.box, frame, X, frame_dt);
   const std::shared_ptr<const PreparedObject> previous = track.points;
   const int previous_frame = track.points_frame;
   const double range = obs.box.center.norm();
@@ -318,6 +319,30 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
   // face it could not see.
   if (r.outcome == RegistrationOutcome::kMeasured) measured = r.motion;
   keep();
+}
+
+bool SlidingWindow::measureLineOfSight(Track& track, const ObjectPoints& world, const Box& box, int frame, const Pose& X,
+                                      double dt) const {
+  if (config_.line_of_sight_pairs <= 0) return false;
+  if (static_cast<int>(world.size()) < config_.line_of_sight_min_points ||
+      !facesTheSensor(box, config_.line_of_sight_max_angle_deg)) {
+    track.sight_frame = -1;  // no pair across this scan
+    return false;
+  }
+  // This scan's face along the previous scan's line of sight: the pair's speed.
+  bool paired = false;
+  if (track.sight_frame == frame - 1 && dt > 0)
+    if (const std::optional<double> range = nearFaceRange(world, track.sight_u)) {
+      track.sight_speeds[frame] = SightSpeed{track.sight_u.head<2>(), (*range - track.sight_range) / dt};
+      paired = true;
+    }
+  const std::optional<Eigen::Vector3d> u = lineOfSight(world, X.translation());
+  track.sight_frame = u ? frame : -1;
+  if (u) {
+    track.sight_u = *u;
+    track.sight_range = *nearFaceRange(world, *u);
+  }
+  return paired;
 }
 
 std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track, const std::optional<BoxHeading>& heading) const {
@@ -385,6 +410,14 @@ Eigen::Vector3d SlidingWindow::youngVehicleVelocity(const Track& track, const Li
     const double dt = 1e-6 * static_cast<double>(b->utime - a->utime);
     const Eigen::Vector3d p_prev = fromBlock(a->pose->data()) * prev->second.b.translation();
     if (const auto v = registeredVelocity(motion.M, motion.information, p_prev, dt, ego_sigma)) registered.push_back(*v);
+  }
+  if (registered.empty()) {
+    // Far away: the face's speed along the line of sight over the last pairs, if any.
+    const int t = frames_.back().frame;
+    std::vector<SightSpeed> pairs;
+    for (auto it = track.sight_speeds.lower_bound(t - config_.line_of_sight_pairs + 1); it != track.sight_speeds.end(); ++it)
+      pairs.push_back(it->second);
+    if (const auto sight = lineOfSightVelocity(pairs, config_.line_of_sight_sigma)) registered.push_back(*sight);
   }
   if (registered.empty()) return line.velocity;
   Eigen::Vector3d out = line.velocity;
@@ -693,6 +726,7 @@ SmoothedPose SlidingWindow::slide() {
     track.changes.erase(track.changes.begin(), track.changes.upper_bound(s));
     track.observations.erase(track.observations.begin(), track.observations.upper_bound(s));
     track.motions.erase(track.motions.begin(), track.motions.upper_bound(s));
+    track.sight_speeds.erase(track.sight_speeds.begin(), track.sight_speeds.upper_bound(s));
   }
   for (Track* track : left_view) {
     track->model = TrackModel::kNotInGraph;

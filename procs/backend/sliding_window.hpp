@@ -20,6 +20,7 @@
 #include "backend/backend_config.hpp"
 #include "backend/backend_types.hpp"
 #include "backend/factor.hpp"
+#include "backend/line_of_sight.hpp"
 #include "backend/marginalizer.hpp"
 #include "backend/motion_evidence.hpp"
 #include "backend/object_model.hpp"
@@ -92,6 +93,13 @@ class SlidingWindow {
       Pose X_prev = Pose::Identity(), X_cur = Pose::Identity();
     };
     std::map<int, Motion> motions;
+    // The face's range along the line of sight in the latest scan with enough points (its frame,
+    // direction and range), and each scan pair's speed along it (frame t -> t-1 to t;
+    // line_of_sight.hpp).
+    int sight_frame = -1;
+    Eigen::Vector3d sight_u = Eigen::Vector3d::UnitX();
+    double sight_range = 0;
+    std::map<int, SightSpeed> sight_speeds;
     Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
   };
 
@@ -105,6 +113,10 @@ class SlidingWindow {
   // previous scan alone, registration_model_frames 1), when it has both, and takes them into it.
   void registerPoints(Track& track, const ObservationInput& obs, int frame, const Pose& X, BackendOutput& out);
   bool registers(const std::string& type) const;
+  // The face's range along the line of sight in this scan (world points) and, when the scan
+  // before had one, the pair's speed along it (line_of_sight.hpp); true when it measured a pair.
+  bool measureLineOfSight(Track& track, const ObjectPoints& world, const Box& box, int frame, const Pose& X,
+                          double dt) const;
   // The velocity of the line through the track's boxes in the window (windowMotion), for a
   // vehicle turned toward the mean heading of its boxes (velocityAlongHeading): a young
   // vehicle's, and a pedestrian's at every age.
@@ -114,7 +126,8 @@ class SlidingWindow {
   };
   std::optional<LineVelocity> boxLineVelocity(const Track& track) const;
   // A young vehicle's line velocity fused with the velocities its registrations in the window
-  // measured (registered_velocity.hpp); the line as it is without registrations.
+  // measured (registered_velocity.hpp); without registrations, with its speed along the line of
+  // sight over its last scan pairs (line_of_sight.hpp); else the line as it is.
   Eigen::Vector3d youngVehicleVelocity(const Track& track, const LineVelocity& line) const;
   // A vehicle's mean bird's-eye heading over its boxes in the window and its standard deviation
   // (rad); none for other classes.

@@ -1,0 +1,56 @@
+#include "backend/line_of_sight.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dlslot::backend {
+namespace {
+
+// The middle value; the mean of the two middle ones for an even count.
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+std::optional<double> nearFaceRange(const ObjectPoints& points, const Eigen::Vector3d& u, double face_depth) {
+  if (points.empty()) return std::nullopt;
+  std::vector<double> d;
+  d.reserve(points.size());
+  for (const Eigen::Vector3f& p : points) d.push_back(p.cast<double>().dot(u));
+  std::sort(d.begin(), d.end());
+  const double limit = d[d.size() / 10] + face_depth;
+  return median(std::vector<double>(d.begin(), std::upper_bound(d.begin(), d.end(), limit)));
+}
+
+bool facesTheSensor(const Box& box, double max_angle_deg) {
+  const Eigen::Vector2d c = box.center.head<2>();
+  if (c.norm() < 1e-6) return false;
+  const double along = std::abs(std::cos(box.yaw) * c.x() + std::sin(box.yaw) * c.y()) / c.norm();
+  return along >= std::cos(max_angle_deg * M_PI / 180.0);
+}
+
+std::optional<Eigen::Vector3d> lineOfSight(const ObjectPoints& points, const Eigen::Vector3d& sensor) {
+  if (points.empty()) return std::nullopt;
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3f& p : points) c += p.cast<double>();
+  Eigen::Vector3d u = c / static_cast<double>(points.size()) - sensor;
+  u.z() = 0;
+  if (u.norm() < 1e-3) return std::nullopt;
+  return u.normalized();
+}
+
+std::optional<VelocityEvidence> lineOfSightVelocity(const std::vector<SightSpeed>& pairs, double sigma_mps) {
+  if (pairs.empty() || !(sigma_mps > 0)) return std::nullopt;
+  std::vector<double> speeds;
+  for (const SightSpeed& p : pairs) speeds.push_back(p.speed);
+  const Eigen::Vector2d u = pairs.back().u;
+  VelocityEvidence v;
+  v.velocity = median(speeds) * u;
+  v.information = u * u.transpose() / (sigma_mps * sigma_mps);
+  return v;
+}
+
+}  // namespace dlslot::backend

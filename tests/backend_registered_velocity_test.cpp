@@ -64,24 +64,26 @@ TEST(RegisteredVelocity, FusionWeighsByInformationAndGatesOutliers) {
   VelocityEvidence r;
   r.velocity = Eigen::Vector2d(9.0, 0.0);
   r.information = 25.0 * Eigen::Matrix2d::Identity();
-  auto [v, used] = fuseVelocities(line, line_cov, {r, r});
-  EXPECT_EQ(used, 2);
-  EXPECT_NEAR(v.x(), (1.0 * 10.0 + 50.0 * 9.0) / 51.0, 1e-12);
-  EXPECT_NEAR(v.y(), 0.0, 1e-12);
+  FusedVelocity f = fuseVelocities(line, line_cov, {r, r});
+  EXPECT_EQ(f.used, 2);
+  EXPECT_NEAR(f.velocity.x(), (1.0 * 10.0 + 50.0 * 9.0) / 51.0, 1e-12);
+  EXPECT_NEAR(f.velocity.y(), 0.0, 1e-12);
+  EXPECT_TRUE(f.covariance.isApprox(Eigen::Matrix2d::Identity() / 51.0, 1e-12));  // the summed information's inverse
   // A partial one (x only) leaves y to the line.
   VelocityEvidence p;
   p.velocity = Eigen::Vector2d(9.5, 3.0);
   p.information << 100.0, 0.0, 0.0, 0.0;
-  std::tie(v, used) = fuseVelocities(line, line_cov, {p});
-  EXPECT_EQ(used, 1);
-  EXPECT_NEAR(v.x(), (10.0 + 100.0 * 9.5) / 101.0, 1e-12);
-  EXPECT_NEAR(v.y(), 0.0, 1e-12);
+  f = fuseVelocities(line, line_cov, {p});
+  EXPECT_EQ(f.used, 1);
+  EXPECT_NEAR(f.velocity.x(), (10.0 + 100.0 * 9.5) / 101.0, 1e-12);
+  EXPECT_NEAR(f.velocity.y(), 0.0, 1e-12);
+  EXPECT_NEAR(f.covariance(1, 1), 1.0, 1e-12);  // y: the line's alone
   // One 5 m/s off (another object's points): beyond the 99 % gate, left out.
   VelocityEvidence bad = r;
   bad.velocity = Eigen::Vector2d(5.0, 0.0);
-  std::tie(v, used) = fuseVelocities(line, line_cov, {r, bad});
-  EXPECT_EQ(used, 1);
-  EXPECT_NEAR(v.x(), (10.0 + 25.0 * 9.0) / 26.0, 1e-12);
+  f = fuseVelocities(line, line_cov, {r, bad});
+  EXPECT_EQ(f.used, 1);
+  EXPECT_NEAR(f.velocity.x(), (10.0 + 25.0 * 9.0) / 26.0, 1e-12);
 }
 
 }  // namespace

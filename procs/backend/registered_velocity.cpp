@@ -43,8 +43,8 @@ std::optional<VelocityEvidence> registeredVelocity(const Pose& M, const Matrix6&
   return v;
 }
 
-std::pair<Eigen::Vector2d, int> fuseVelocities(const Eigen::Vector2d& line_velocity, const Eigen::Matrix2d& line_covariance,
-                                               const std::vector<VelocityEvidence>& registered) {
+FusedVelocity fuseVelocities(const Eigen::Vector2d& line_velocity, const Eigen::Matrix2d& line_covariance,
+                             const std::vector<VelocityEvidence>& registered) {
   const Eigen::Matrix2d line_info = line_covariance.inverse();
   Eigen::Matrix2d info = line_info;
   Eigen::Vector2d eta = line_info * line_velocity;
@@ -70,7 +70,11 @@ std::pair<Eigen::Vector2d, int> fuseVelocities(const Eigen::Vector2d& line_veloc
     eta += r.information * r.velocity;
     ++used;
   }
-  return {info.ldlt().solve(eta), used};
+  FusedVelocity out;
+  out.velocity = info.ldlt().solve(eta);
+  out.covariance = info.inverse();
+  out.used = used;
+  return out;
 }
 
 }  // namespace dlslot::backend

@@ -32,8 +32,13 @@ std::optional<VelocityEvidence> registeredVelocity(const Pose& M, const Matrix6&
 // The information-weighted mean of a line's velocity (covariance line_covariance, full rank) and
 // registered velocities. A registration whose velocity disagrees with the line beyond the
 // chi-square gate (99 % for its measured directions) is another object's or a failed one and
-// is left out. Returns the fused velocity and how many registrations it used.
-std::pair<Eigen::Vector2d, int> fuseVelocities(const Eigen::Vector2d& line_velocity, const Eigen::Matrix2d& line_covariance,
-                                               const std::vector<VelocityEvidence>& registered);
+// is left out. Returns the fused velocity, its covariance and how many registrations it used.
+struct FusedVelocity {
+  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity();
+  int used = 0;
+};
+FusedVelocity fuseVelocities(const Eigen::Vector2d& line_velocity, const Eigen::Matrix2d& line_covariance,
+                             const std::vector<VelocityEvidence>& registered);
 
 }  // namespace dlslot::backend

@@ -128,7 +128,7 @@ class SlidingWindow {
   // A young vehicle's line velocity fused with the velocities its registrations in the window
   // measured (registered_velocity.hpp); without registrations, with its speed along the line of
   // sight over its last scan pairs (line_of_sight.hpp); else the line as it is.
-  Eigen::Vector3d youngVehicleVelocity(const Track& track, const LineVelocity& line) const;
+  LineVelocity youngVehicleVelocity(const Track& track, const LineVelocity& line) const;
   // A vehicle's mean bird's-eye heading over its boxes in the window and its standard deviation
   // (rad); none for other classes.
   struct BoxHeading {

@@ -6,10 +6,10 @@
 // points it has lie on the one face the sensor sees (an oncoming car's front, a leading car's back),
 // and a lidar measures range to 2 cm: from one scan to the next that face moves by the car's
 // motion along the line of sight. Measured on the simulated highway and highway-jam (pairs with no
-// registration, against the true velocity): 0.24-0.39 m/s RMSE for pairs with 20+ points in both
-// scans, but 13-30 % of pairs off by more than 1 m/s (a ring crossing from bumper to bonnet, a
-// neighbour's points in the box), and half of them below 20 points. Hence the median over the
-// last few pairs, and a test against the boxes' line before it is used (fuseVelocities).
+// registration, against the true velocity), pairs with 20+ points in both scans: 0.24-0.39 m/s
+// RMS among those within 1 m/s, but 13-31 % beyond it (a ring crossing from bumper to bonnet, a
+// neighbour's points in the box); below 20 points, half of them beyond it. Hence the median over
+// the last few pairs, and a test against the boxes' line before it is used (fuseVelocities).
 #pragma once
 
 #include <Eigen/Core>

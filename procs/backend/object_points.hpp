@@ -1,6 +1,6 @@
 // Each observed object's points in a scan, for the per-object registration: the points inside its
-// box grown by a margin (wider far away, where the box is less certain: BackendConfig), above the ground (the box's floor raised by a clearance: the same volume
-// A-LOAM* removes, dlslot/box_filter.hpp).
+// box grown by a margin (wider far away, where the box is less certain: BackendConfig), above the
+// ground (the box's floor raised by a clearance: the volume A-LOAM* removes, dlslot/box_filter.hpp).
 #pragma once
 
 #include <vector>

@@ -356,7 +356,8 @@ std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track, const st
   }
   // The boxes' noise at their mean range.
   const double range = positions.empty() ? 0.0 : range_sum / positions.size();
-  const double sigma = 0.5 * (config_.observation_sigma[0] + config_.observation_sigma[1]) * config_.observationNoiseGrowth(range);
+  const double sigma =
+      0.5 * (config_.observation_sigma[0] + config_.observation_sigma[1]) * config_.observationNoiseGrowth(range);
   // Boxes more than 5 sigmas off the consensus line are another object's (the tracker's wrong
   // associations, often before a gap). 5 left every tuning run's velocity RMSE as it was but
   // highway-jam 3's (0.786 -> 0.556 m/s: an oncoming van whose first box was another's); 3 and 2
@@ -415,8 +416,8 @@ SlidingWindow::LineVelocity SlidingWindow::youngVehicleVelocity(const Track& tra
     // Far away: the face's speed along the line of sight over the last pairs, if any.
     const int t = frames_.back().frame;
     std::vector<SightSpeed> pairs;
-    for (auto it = track.sight_speeds.lower_bound(t - config_.line_of_sight_pairs + 1); it != track.sight_speeds.end(); ++it)
-      pairs.push_back(it->second);
+    const auto first = track.sight_speeds.lower_bound(t - config_.line_of_sight_pairs + 1);
+    for (auto it = first; it != track.sight_speeds.end(); ++it) pairs.push_back(it->second);
     if (const auto sight = lineOfSightVelocity(pairs, config_.line_of_sight_sigma)) registered.push_back(*sight);
   }
   if (registered.empty()) return line;

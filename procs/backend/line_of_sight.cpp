@@ -3,17 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "dlslot/timing_stats.hpp"
+
 namespace dlslot::backend {
-namespace {
-
-// The middle value; the mean of the two middle ones for an even count.
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-}  // namespace
 
 std::optional<double> nearFaceRange(const ObjectPoints& points, const Eigen::Vector3d& u, double face_depth) {
   if (points.empty()) return std::nullopt;

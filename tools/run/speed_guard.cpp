@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "dlslot/timing_stats.hpp"
+
 namespace dlslot::run {
 namespace {
 
@@ -36,16 +38,6 @@ SpeedFigures speedFromYaml(const YAML::Node& node, const std::string& where) {
     for (size_t i = 0; i < load.size(); ++i) f.load.push_back(load[i].as<double>());
   return f;
 }
-
-namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-}  // namespace
 
 SpeedFigures medianOf(const std::vector<SpeedFigures>& runs) {
   SpeedFigures out;

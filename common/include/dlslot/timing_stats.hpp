@@ -1,4 +1,4 @@
-// Mean / p95 / max of per-frame processing times.
+// Mean / p95 / max of per-frame processing times, and a sample's median.
 #pragma once
 
 #include <cstddef>
@@ -18,5 +18,8 @@ class TimingStats {
  private:
   std::vector<double> samples_;
 };
+
+// The middle value; the mean of the two middle ones for an even count; 0 when empty.
+double median(std::vector<double> values);
 
 }  // namespace dlslot

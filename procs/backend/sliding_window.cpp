@@ -270,7 +270,8 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
     p += t * (ego.angular.cross(p) + ego.velocity - v_obj);
     world.push_back((X * p).cast<float>());
   }
-  out.line_of_sight_pairs += measureLineOfSight(track, world, obs.box, frame, X, frame_dt);
+  // Only the young path reads it (youngVehicleVelocity): a velocity from the chain needs none.
+  if (!track.velocity_from_chain) out.line_of_sight_pairs += measureLineOfSight(track, world, obs.box, frame, X, frame_dt);
   const std::shared_ptr<const PreparedObject> previous = track.points;
   const int previous_frame = track.points_frame;
   const double range = obs.box.center.norm();
@@ -326,22 +327,19 @@ bool SlidingWindow::measureLineOfSight(Track& track, const ObjectPoints& world, 
   if (config_.line_of_sight_pairs <= 0) return false;
   if (static_cast<int>(world.size()) < config_.line_of_sight_min_points ||
       !facesTheSensor(box, config_.line_of_sight_max_angle_deg)) {
-    track.sight_frame = -1;  // no pair across this scan
+    track.sight.reset();  // no pair across this scan
     return false;
   }
   // This scan's face along the previous scan's line of sight: the pair's speed.
   bool paired = false;
-  if (track.sight_frame == frame - 1 && dt > 0)
-    if (const std::optional<double> range = nearFaceRange(world, track.sight_u)) {
-      track.sight_speeds[frame] = SightSpeed{track.sight_u.head<2>(), (*range - track.sight_range) / dt};
+  if (track.sight && track.sight->frame == frame - 1 && dt > 0)
+    if (const std::optional<double> range = nearFaceRange(world, track.sight->u)) {
+      track.sight_speeds[frame] = SightSpeed{track.sight->u.head<2>(), (*range - track.sight->range) / dt};
       paired = true;
     }
-  const std::optional<Eigen::Vector3d> u = lineOfSight(world, X.translation());
-  track.sight_frame = u ? frame : -1;
-  if (u) {
-    track.sight_u = *u;
-    track.sight_range = *nearFaceRange(world, *u);
-  }
+  track.sight.reset();
+  if (const std::optional<Eigen::Vector3d> u = lineOfSight(world, X.translation()))
+    track.sight = Track::SightFace{frame, *u, *nearFaceRange(world, *u)};
   return paired;
 }
 
@@ -682,9 +680,10 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
       box.center = e.pose.translation();
       box.size = e.size;
       box.yaw = yawOf(e.pose.linear());
+      const BoxContainment within(box, config_.registration_box_margin);  // the yaw's sine and cosine once
       ObjectPoints own;
       for (const Eigen::Vector3f& p : track.accumulated.points())
-        if (box.contains(p.cast<double>(), config_.registration_box_margin)) own.push_back(p);
+        if (within.contains(p.x(), p.y(), p.z())) own.push_back(p);
       const RefinedBox r = refinedBox(e.pose, e.size, own, fromBlock(frames_.back().pose->data()).translation(),
                                       config_.registration.min_points);
       e.pose = r.pose;

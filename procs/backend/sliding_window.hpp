@@ -93,12 +93,15 @@ class SlidingWindow {
       Pose X_prev = Pose::Identity(), X_cur = Pose::Identity();
     };
     std::map<int, Motion> motions;
-    // The face's range along the line of sight in the latest scan with enough points (its frame,
-    // direction and range), and each scan pair's speed along it (frame t -> t-1 to t;
+    // The face along the line of sight in the latest scan that measured one (its frame, the
+    // direction and the face's range), and each scan pair's speed along it (frame t -> t-1 to t;
     // line_of_sight.hpp).
-    int sight_frame = -1;
-    Eigen::Vector3d sight_u = Eigen::Vector3d::UnitX();
-    double sight_range = 0;
+    struct SightFace {
+      int frame = -1;
+      Eigen::Vector3d u = Eigen::Vector3d::UnitX();
+      double range = 0;
+    };
+    std::optional<SightFace> sight;
     std::map<int, SightSpeed> sight_speeds;
     Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
   };

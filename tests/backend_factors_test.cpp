@@ -636,4 +636,10 @@ TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
   EXPECT_EQ(c.odometry_check.probability, 0.9999);
   for (const char* bad : {"0", "1", "1.5"}) expectRefused("odometry_check_probability", bad);
   expectRefused("odometry_check_min_support", "0");
+  // A class's heading sigma replaces the box's rz when larger, for moving objects and landmarks.
+  EXPECT_EQ(c.boxSigma("Cyclist", true)[5], 0.57);
+  EXPECT_EQ(c.boxSigma("Cyclist", false)[5], 0.57);
+  EXPECT_EQ(c.boxSigma("Car", true), c.observation_sigma);
+  EXPECT_EQ(c.boxSigma("Car", false), c.landmark_sigma);
+  for (const char* bad : {"{Cyclist: 0}", "{Cyclist: fast}", "[0.3]"}) expectRefused("heading_sigma_by_type", bad);
 }

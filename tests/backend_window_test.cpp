@@ -593,6 +593,62 @@ TEST(BackendSlidingWindow, APedestriansVelocitySurvivesStrayBoxes) {
   EXPECT_LT(far, 0.6);
 }
 
+namespace {
+
+// The mean velocity error (m/s, frames 15-39) of a cyclist at 4.5 m/s tracked on a pedestrian
+// detector's boxes, whose heading is 0.4 rad off its own, plus 0.3 rad of noise (PointRCNN's
+// pedestrian boxes on KITTI's cyclists: median 0.35 rad off), missed in every fifth frame, its
+// boxes' heading believed to `heading_sigma` (rad; 0: observation_sigma's 0.1).
+double cyclistOnPedestrianBoxes(double heading_sigma, unsigned seed) {
+  SimScene scene;
+  scene.seed = seed;
+  scene.ego = constantTwist(Pose::Identity(), 8.0, 0.0);
+  scene.box_noise << 0.08, 0.08, 0.03;
+  scene.yaw_noise = 0.3;
+  SimObject cyclist;
+  cyclist.id = 4;
+  cyclist.type = "Cyclist";
+  cyclist.size = Eigen::Vector3d(0.9, 0.7, 1.7);
+  const double heading = 0.3, speed = 4.5;
+  const auto path = constantTwist(planarPose(12, -4, heading), speed, 0.0);
+  cyclist.pose = [path](double t) { return path(t) * planarPose(0, 0, 0.4); };
+  cyclist.visible = [](int f) { return f % 5 != 4; };
+  scene.objects = {cyclist};
+  BackendConfig c;
+  c.compute_covariance = false;
+  c.observation_sigma[5] = 0.1;
+  if (heading_sigma > 0) c.heading_sigma_by_type["Cyclist"] = heading_sigma;
+  SlidingWindow window(c);
+  const auto out = run(window, scene.generate(40));
+  const Eigen::Vector3d truth(speed * std::cos(heading), speed * std::sin(heading), 0.0);
+  double sum = 0;
+  int n = 0;
+  for (int t = 15; t < 40; ++t)
+    for (const TrackEstimate& e : out[t].tracks)
+      if (e.id == 4) sum += (e.velocity - truth).head<2>().norm(), ++n;
+  return n ? sum / n : 1e9;
+}
+
+}  // namespace
+
+// A cyclist moves along its heading (the vehicle-motion factor), so a heading believed from its
+// boxes turns its velocity with them; believed as well as the detector knows it, its motion
+// decides (the real slice's cyclist: 1.2 -> 0.26 m/s). With so weak a heading, a box is turned
+// round only against the track's newest pose: extrapolated by a young chain's yaw rate, it turned
+// right boxes round and the chain spun.
+TEST(BackendSlidingWindow, ACyclistsVelocityFollowsItsMotionNotAPedestrianBoxsHeading) {
+  double believed = 0, as_measured = 0;
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    const double a = cyclistOnPedestrianBoxes(0.0, seed), b = cyclistOnPedestrianBoxes(0.57, seed);
+    std::printf("seed %u: cyclist on pedestrian boxes, mean velocity error %.2f m/s (heading sigma 0.1), %.2f (0.57)\n",
+                seed, a, b);
+    believed = std::max(believed, a);
+    as_measured = std::max(as_measured, b);
+  }
+  EXPECT_GT(believed, 0.25);
+  EXPECT_LT(as_measured, 0.2);
+}
+
 TEST(BackendSlidingWindow, TwoStageAndOdometryOnlyKeepTheOdometryPoses) {
   const SimScene scene = streetScene();
   const auto inputs = scene.generate(25);

@@ -1,5 +1,6 @@
 #include "backend/backend_config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -50,6 +51,13 @@ void require(bool ok, const ConfigSection& s, const std::string& key, const std:
 
 }  // namespace
 
+Vector6 BackendConfig::boxSigma(const std::string& type, bool moving) const {
+  Vector6 sigma = moving ? observation_sigma : landmark_sigma;
+  if (const auto it = heading_sigma_by_type.find(type); it != heading_sigma_by_type.end())
+    sigma[5] = std::max(sigma[5], it->second);
+  return sigma;
+}
+
 BackendConfig BackendConfig::read(ConfigSection& s) {
   BackendConfig c;
   const std::string mode = s.get<std::string>("mode");
@@ -71,6 +79,13 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   s.get("observation_sigma_growth_per_m", c.observation_sigma_growth_per_m);
   c.vehicle_motion_sigma = readSigmas<4>(s, "vehicle_motion_sigma", "lateral m, vertical m, roll rad, pitch rad");
   s.get("vehicle_types", c.vehicle_types);
+  ConfigSection headings = s.section("heading_sigma_by_type");
+  for (const std::string& type : headings.keys()) {
+    const double sigma = headings.get<double>(type);
+    require(sigma > 0.0, headings, type, "a heading sigma > 0 (rad)");
+    c.heading_sigma_by_type[type] = sigma;
+  }
+  headings.finish();
   require(c.observation_sigma_growth_per_m >= 0.0, s, "observation_sigma_growth_per_m", "a number >= 0 (1/m)");
   s.get("degraded_odometry_scale", c.degraded_odometry_scale);
   require(c.degraded_odometry_scale >= 1.0, s, "degraded_odometry_scale", "a number >= 1");

@@ -2,6 +2,7 @@
 // covariances of eq. 12 per factor type, robust loss, static/dynamic decision, solver.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -45,12 +46,18 @@ struct BackendConfig {
   // the classes it applies to.
   Eigen::Vector4d vehicle_motion_sigma = Eigen::Vector4d(0.02, 0.02, 0.002, 0.002);
   std::vector<std::string> vehicle_types = {"Car", "Van", "Truck", "Tram", "Cyclist"};
+  // A detector's heading is as good as its class lets it be: per class, the rz sigma of its
+  // boxes when that is more than observation_sigma's (landmark_sigma's) rz.
+  std::map<std::string, double> heading_sigma_by_type;
   // A detector's box position error grows with range (fewer points on the object): the
   // translation sigmas of (landmark) observations are the ones above times (1 + this x range in
   // m); 0 keeps them constant.
   double observation_sigma_growth_per_m = 0.0;
   // Factor by which a box's translation sigmas grow at this range.
   double observationNoiseGrowth(double range_m) const { return 1.0 + observation_sigma_growth_per_m * range_m; }
+  // The sigmas of a box of this class (a moving object's or a landmark's): the configured ones,
+  // with the class's heading sigma when that is larger.
+  Vector6 boxSigma(const std::string& type, bool moving) const;
   // Odometry sigmas are multiplied by this when the odometry fell back to a prediction or
   // did not arrive (then the pose is predicted with constant velocity).
   double degraded_odometry_scale = 10.0;

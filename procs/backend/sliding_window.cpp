@@ -175,7 +175,7 @@ OdometryCheck SlidingWindow::checkOdometryFactor(const BackendInput& in, const P
     if (moving && (!track.velocity || !(dt > 0))) continue;
     const Pose& b_prev = before->second.b;
     const Pose b_cur = obs.box.pose();
-    const Vector6& sigma = moving ? config_.observation_sigma : config_.landmark_sigma;
+    const Vector6 sigma = config_.boxSigma(track.type, moving);
     MotionEvidence e;
     e.track_id = obs.track_id;
     e.moving = moving;
@@ -365,7 +365,7 @@ std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track, const st
 
 std::optional<SlidingWindow::BoxHeading> SlidingWindow::boxHeading(const Track& track) const {
   if (!isVehicle(track.type)) return std::nullopt;
-  // The mean heading of its boxes in the window (each box's own yaw noise is observation_sigma's rz).
+  // The mean heading of its boxes in the window (each box's own yaw noise is its class's rz).
   Eigen::Vector2d heading = Eigen::Vector2d::Zero();
   int n = 0;
   for (const auto& [f, obs] : track.observations)
@@ -375,7 +375,7 @@ std::optional<SlidingWindow::BoxHeading> SlidingWindow::boxHeading(const Track& 
       ++n;
     }
   if (n == 0 || heading.norm() < 1e-9) return std::nullopt;
-  return BoxHeading{heading.normalized(), config_.observation_sigma[5] / std::sqrt(double(n))};
+  return BoxHeading{heading.normalized(), config_.boxSigma(track.type, true)[5] / std::sqrt(double(n))};
 }
 
 std::optional<SlidingWindow::LineVelocity> SlidingWindow::boxLineVelocity(const Track& track) const {
@@ -460,11 +460,11 @@ void SlidingWindow::addTrackObservation(Track& track, int frame) {
     return sigma;
   };
   if (track.model == TrackModel::kStatic) {
-    addFactor(LandmarkObservationFactor::Create(obs.b, sqrtInformation(sigmas(config_.landmark_sigma))), true,
+    addFactor(LandmarkObservationFactor::Create(obs.b, sqrtInformation(sigmas(config_.boxSigma(track.type, false)))), true,
               {x, track.landmark->data()});
   } else {
     extendChain(track, frame, X * obs.b);
-    addFactor(ObservationFactor::Create(obs.b, sqrtInformation(sigmas(config_.observation_sigma))), true,
+    addFactor(ObservationFactor::Create(obs.b, sqrtInformation(sigmas(config_.boxSigma(track.type, true)))), true,
               {x, track.poses.at(frame)->data()});
   }
   obs.in_graph = true;
@@ -802,10 +802,15 @@ const SlidingWindow::EgoFrame* SlidingWindow::findFrame(int frame) const {
 
 Pose SlidingWindow::alignedBox(const Track& track, const Pose& X, const Box& box) const {
   // A box and the box turned by pi are the same box; detectors flip headings. Keep the heading
-  // closest to what the track already has (its estimate, else its last observation).
+  // closest to what the track already has: its newest pose, not extrapolated by its yaw rate (a
+  // young chain's yaw rate comes from two or three boxes; a cyclist's scatter by 0.3 rad, and
+  // two frames of such a rate turned its next, right box round: intersection seed 2); else its
+  // last observation.
   std::optional<double> reference;
-  if (const auto predicted = predictedPose(track)) {
-    reference = yawOf(predicted->linear());
+  if (track.model == TrackModel::kStatic) {
+    reference = yawOf(fromBlock(track.landmark->data()).linear());
+  } else if (track.model == TrackModel::kDynamic && !track.poses.empty()) {
+    reference = yawOf(fromBlock(track.poses.rbegin()->second->data()).linear());
   } else if (!track.observations.empty()) {
     const auto& [f, obs] = *track.observations.rbegin();
     if (const EgoFrame* ego = findFrame(f)) reference = yawOf(fromBlock(ego->pose->data()).linear() * obs.b.linear());

@@ -642,4 +642,6 @@ TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
   EXPECT_EQ(c.boxSigma("Car", true), c.observation_sigma);
   EXPECT_EQ(c.boxSigma("Car", false), c.landmark_sigma);
   for (const char* bad : {"{Cyclist: 0}", "{Cyclist: fast}", "[0.3]"}) expectRefused("heading_sigma_by_type", bad);
+  EXPECT_EQ(c.walker_line_span_s, 2.0);
+  expectRefused("walker_line_span_s", "-1");
 }

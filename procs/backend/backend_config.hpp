@@ -115,6 +115,9 @@ struct BackendConfig {
   // many frames. With the constant-acceleration factor the newest pose change (1) is the best
   // estimate; a longer chord lags behind a braking car by half its span.
   int velocity_frames = 1;
+  // A pedestrian's (any non-vehicle's) velocity: the line through its boxes of the last this many
+  // seconds, the window's and those that left it; the window's alone when shorter.
+  double walker_line_span_s = 0.0;
   double dynamic_min_sigmas = 2.0;
   // A landmark turns dynamic when its last `switch_frames` observations each lie farther than
   // `switch_distance` (m, bird's-eye) from it (a parked car pulls out).

@@ -344,16 +344,18 @@ bool SlidingWindow::measureLineOfSight(Track& track, const ObjectPoints& world, 
 }
 
 std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track, const std::optional<BoxHeading>& heading) const {
-  std::vector<TimedPosition> positions;
+  std::vector<TimedPosition> positions(track.past_boxes.begin(), track.past_boxes.end());
   double range_sum = 0;
+  int in_window = 0;
   for (const auto& [f, obs] : track.observations) {
     const EgoFrame* ego = findFrame(f);
     if (!ego) continue;
     positions.push_back({1e-6 * static_cast<double>(ego->utime), fromBlock(ego->pose->data()) * obs.b.translation()});
     range_sum += obs.b.translation().norm();
+    ++in_window;
   }
-  // The boxes' noise at their mean range.
-  const double range = positions.empty() ? 0.0 : range_sum / positions.size();
+  // The boxes' noise at the window's mean range.
+  const double range = in_window == 0 ? 0.0 : range_sum / in_window;
   const double sigma =
       0.5 * (config_.observation_sigma[0] + config_.observation_sigma[1]) * config_.observationNoiseGrowth(range);
   // Boxes more than 5 sigmas off the consensus line are another object's (the tracker's wrong
@@ -735,6 +737,16 @@ SmoothedPose SlidingWindow::slide() {
     factors_.erase(std::remove_if(factors_.begin(), factors_.end(), dropped), factors_.end());
   marginalizeBlocks(leaving);
 
+  // A walker's leaving box stays in its line for walker_line_span_s (walkers keep their pace
+  // longer than the window lasts; the config says how long, measured on KITTI).
+  const double newest = 1e-6 * static_cast<double>(frames_.back().utime);
+  for (auto& [id, track] : tracks_) {
+    if (isVehicle(track.type)) continue;
+    if (const auto it = track.observations.find(s); it != track.observations.end())
+      track.past_boxes.push_back({1e-6 * static_cast<double>(oldest.utime), smoothed.pose * it->second.b.translation()});
+    while (!track.past_boxes.empty() && newest - track.past_boxes.front().t > config_.walker_line_span_s)
+      track.past_boxes.pop_front();
+  }
   for (auto& [id, track] : tracks_) {
     track.poses.erase(track.poses.begin(), track.poses.upper_bound(s));
     track.changes.erase(track.changes.begin(), track.changes.upper_bound(s));
@@ -749,6 +761,7 @@ SmoothedPose SlidingWindow::slide() {
     track->changes.clear();
     track->velocity.reset();
     track->velocity_from_chain = false;
+    track->past_boxes.clear();
   }
   // Tracks with nothing left in the window are forgotten (first_seen_ keeps their age).
   for (auto it = tracks_.begin(); it != tracks_.end();)

@@ -73,6 +73,9 @@ class SlidingWindow {
     std::map<int, Block> poses;     // dynamic: frame -> o_frame
     std::map<int, Block> changes;   // dynamic: frame f -> c_f^{f+1}
     std::map<int, Observation> observations;  // frames in the window
+    // A walker's boxes that left the window (world, the ego pose as estimated when they left),
+    // within walker_line_span_s of the window's oldest frame.
+    std::deque<TimedPosition> past_boxes;
     // The motion last estimated (world frame): kept while the window holds too little of the
     // chain to estimate it again (coasting, or about to leave).
     std::optional<Eigen::Vector3d> velocity;

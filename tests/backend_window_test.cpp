@@ -634,6 +634,51 @@ TEST(BackendSlidingWindow, AWalkersLineOutlastsTheWindow) {
 
 namespace {
 
+// Frames a pedestrian at `speed` m/s (boxes 0.15 m off, the tracker guessing it still) is
+// published still, over 10 seeds, after its first output; a still one judged again at every
+// frame at `switch_sigmas` (0: never).
+int framesPublishedStill(double speed, double switch_sigmas) {
+  int still = 0;
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    SimScene scene;
+    scene.seed = seed;
+    scene.ego = constantTwist(Pose::Identity(), 5.0, 0.0);
+    scene.box_noise << 0.15, 0.15, 0.03;
+    scene.yaw_noise = 0.3;
+    SimObject walker;
+    walker.id = 6;
+    walker.type = "Pedestrian";
+    walker.size = Eigen::Vector3d(0.8, 0.6, 1.7);
+    walker.pose = constantTwist(planarPose(15, -5, M_PI / 2), speed, 0.0);
+    scene.objects = {walker};
+    BackendConfig c;
+    c.compute_covariance = false;
+    c.walker_line_span_s = 2.0;
+    c.walker_switch_min_sigmas = switch_sigmas;
+    SlidingWindow window(c);
+    for (const BackendOutput& out : run(window, scene.generate(40)))
+      for (const TrackEstimate& e : out.tracks) still += e.id == 6 && !e.dynamic;
+  }
+  return still;
+}
+
+}  // namespace
+
+// A walker its first 3-4 boxes could not tell from a standing pedestrian is judged again at every
+// frame as its line grows: before, it waited to be switch_distance from its landmark, which
+// follows its boxes. A standing pedestrian stays still at 3 sigmas (at 2, now and then not).
+TEST(BackendSlidingWindow, AWalkerStartedStillIsJudgedAgainAsItsLineGrows) {
+  const int before = framesPublishedStill(1.2, 0.0), walking = framesPublishedStill(1.2, 3.0);
+  const int standing = framesPublishedStill(0.0, 3.0), standing_at_2 = framesPublishedStill(0.0, 2.0);
+  std::printf("pedestrian published still (of 380 frames): walking at 1.2 m/s %d (not judged again: %d), standing "
+              "%d (at 2 sigmas: %d)\n", walking, before, standing, standing_at_2);
+  EXPECT_LT(walking, 0.7 * before);
+  EXPECT_EQ(standing, 380);
+  EXPECT_LT(standing_at_2, 380);
+}
+
+namespace {
+
 // The mean velocity error (m/s, frames 15-39) of a cyclist at 4.5 m/s tracked on a pedestrian
 // detector's boxes, whose heading is 0.4 rad off its own, plus 0.3 rad of noise (PointRCNN's
 // pedestrian boxes on KITTI's cyclists: median 0.35 rad off), missed in every fifth frame, its

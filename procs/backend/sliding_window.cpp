@@ -518,8 +518,14 @@ int SlidingWindow::switchMovingLandmarks() {
     std::vector<Eigen::Vector3d> positions;
     for (const auto& [f, obs] : track.observations)
       if (obs.in_graph) positions.push_back(fromBlock(findFrame(f)->pose->data()) * obs.b.translation());
-    if (leftLandmark(positions, fromBlock(track.landmark->data()).translation(), config_.switch_distance,
-                     config_.switch_frames)) {
+    bool moved = leftLandmark(positions, fromBlock(track.landmark->data()).translation(), config_.switch_distance,
+                              config_.switch_frames);
+    // A walker started still on its first 3-4 boxes is judged again at every frame by its line: it
+    // seldom leaves its landmark by switch_distance, as the landmark follows its boxes.
+    if (!moved && !isVehicle(track.type) && config_.walker_switch_min_sigmas > 0)
+      if (const std::optional<SpeedFit> fit = windowMotion(track, std::nullopt))
+        moved = fit->speed > config_.static_max_speed && fit->speed > config_.walker_switch_min_sigmas * fit->sigma;
+    if (moved) {
       makeDynamic(track);
       ++switched;
     }

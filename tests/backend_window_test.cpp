@@ -542,21 +542,30 @@ TEST(BackendSlidingWindow, FactorMembershipFollowsEquation12) {
 
 namespace {
 
-// The worst velocity error of a walker (1.4 m/s) the tracker now and then gives a stray box
-// `aside` m to its side (a wrong association in a crowd), from frame 12 on.
-double walkerWithStrayBoxes(double aside) {
+// A pedestrian (id 5) at `speed` m/s crossing 20 m ahead of an ego driving at 8 m/s, its boxes
+// `box_noise` m (and `yaw_noise` rad) off.
+SimScene walkerScene(double speed, double box_noise, double yaw_noise, unsigned seed = 1) {
   SimScene scene;
+  scene.seed = seed;
   scene.ego = constantTwist(Pose::Identity(), 8.0, 0.0);
-  scene.box_noise << 0.08, 0.08, 0.03;
-  scene.yaw_noise = 0.05;
+  scene.box_noise << box_noise, box_noise, 0.03;
+  scene.yaw_noise = yaw_noise;
   SimObject walker;
   walker.id = 5;
   walker.type = "Pedestrian";
   walker.size = Eigen::Vector3d(0.8, 0.6, 1.7);
-  walker.pose = constantTwist(planarPose(20, -6, M_PI / 2), 1.4, 0.0);
-  const std::set<int> stray{14, 19, 23, 26, 31, 35};
-  walker.visible = [stray](int f) { return !stray.count(f); };
+  walker.pose = constantTwist(planarPose(20, -6, M_PI / 2), speed, 0.0);
   scene.objects = {walker};
+  return scene;
+}
+
+// The worst velocity error of a walker (1.4 m/s) the tracker now and then gives a stray box
+// `aside` m to its side (a wrong association in a crowd), from frame 12 on.
+double walkerWithStrayBoxes(double aside) {
+  SimScene scene = walkerScene(1.4, 0.08, 0.05);
+  const SimObject walker = scene.objects[0];
+  const std::set<int> stray{14, 19, 23, 26, 31, 35};
+  scene.objects[0].visible = [stray](int f) { return !stray.count(f); };
   for (int f : stray) {
     const Pose b = scene.egoTruth(f).inverse() * walker.pose(scene.time(f)) * planarPose(0, aside, 0);
     ObservationInput obs;
@@ -598,16 +607,7 @@ namespace {
 // The RMS velocity error (m/s, frames 25-59) of a walker at 1.4 m/s whose boxes jitter by 0.15 m,
 // its line spanning `span` s (0: the window's boxes alone).
 double walkerVelocityError(double span) {
-  SimScene scene;
-  scene.ego = constantTwist(Pose::Identity(), 8.0, 0.0);
-  scene.box_noise << 0.15, 0.15, 0.03;
-  scene.yaw_noise = 0.3;
-  SimObject walker;
-  walker.id = 5;
-  walker.type = "Pedestrian";
-  walker.size = Eigen::Vector3d(0.8, 0.6, 1.7);
-  walker.pose = constantTwist(planarPose(20, -6, M_PI / 2), 1.4, 0.0);
-  scene.objects = {walker};
+  const SimScene scene = walkerScene(1.4, 0.15, 0.3);
   BackendConfig c;
   c.compute_covariance = false;
   c.walker_line_span_s = span;
@@ -640,24 +640,14 @@ namespace {
 int framesPublishedStill(double speed, double switch_sigmas) {
   int still = 0;
   for (unsigned seed = 1; seed <= 10; ++seed) {
-    SimScene scene;
-    scene.seed = seed;
-    scene.ego = constantTwist(Pose::Identity(), 5.0, 0.0);
-    scene.box_noise << 0.15, 0.15, 0.03;
-    scene.yaw_noise = 0.3;
-    SimObject walker;
-    walker.id = 6;
-    walker.type = "Pedestrian";
-    walker.size = Eigen::Vector3d(0.8, 0.6, 1.7);
-    walker.pose = constantTwist(planarPose(15, -5, M_PI / 2), speed, 0.0);
-    scene.objects = {walker};
+    const SimScene scene = walkerScene(speed, 0.15, 0.3, seed);
     BackendConfig c;
     c.compute_covariance = false;
     c.walker_line_span_s = 2.0;
     c.walker_switch_min_sigmas = switch_sigmas;
     SlidingWindow window(c);
     for (const BackendOutput& out : run(window, scene.generate(40)))
-      for (const TrackEstimate& e : out.tracks) still += e.id == 6 && !e.dynamic;
+      for (const TrackEstimate& e : out.tracks) still += e.id == 5 && !e.dynamic;
   }
   return still;
 }

@@ -1,6 +1,7 @@
 #include "backend/motion_evidence.hpp"
 
 #include <cmath>
+#include <limits>
 
 namespace dlslot::backend {
 
@@ -33,24 +34,35 @@ std::optional<SpeedFit> fitSpeedAmongOutliers(const std::vector<TimedPosition>& 
                                               double inlier_sigmas, const Eigen::Vector2d* heading) {
   if (positions.size() <= (heading ? 2u : 3u)) return fitSpeed(positions, position_sigma);
   // The line through the pair of positions with the most others within inlier_sigmas x
-  // position_sigma of it (bird's-eye; ties: the smaller squared residual), then the least-squares
-  // line through those. A residual test after a least-squares fit misses the stray box: with four
-  // boxes the line it bends passes nearer the stray one than the others.
+  // position_sigma of it (bird's-eye), then the least-squares line through those. A residual test
+  // after a least-squares fit misses the stray box: with four boxes the line it bends passes nearer
+  // the stray one than the others. Ties go to the line whose inliers reach the latest time (the
+  // object the track is now: two far cars a lane apart, two boxes each, gave one track's first
+  // output the older car's speed, 9.4 m/s off; highway-jam seed 6), then to the smaller squared
+  // residual.
   const double gate = inlier_sigmas * position_sigma;
-  // The positions within the gate of the line through positions i and j, and their squared residuals.
+  struct Support {
+    int n = 0;
+    double latest = -std::numeric_limits<double>::infinity(), cost = 0;
+    bool betterThan(const Support& o) const {
+      if (n != o.n) return n > o.n;
+      if (latest != o.latest) return latest > o.latest;
+      return cost < o.cost;
+    }
+  };
+  // The positions within the gate of the line through positions i and j, and their support.
   auto inliers = [&](size_t i, size_t j, std::vector<TimedPosition>* out) {
     const Eigen::Vector3d v = (positions[j].p - positions[i].p) / (positions[j].t - positions[i].t);
-    int n = 0;
-    double cost = 0;
+    Support s;
     for (const TimedPosition& tp : positions) {
       const double r = (tp.p - positions[i].p - v * (tp.t - positions[i].t)).head<2>().norm();
       if (r > gate) continue;
-      ++n, cost += r * r;
+      ++s.n, s.cost += r * r, s.latest = std::max(s.latest, tp.t);
       if (out) out->push_back(tp);
     }
-    return std::make_pair(n, cost);
+    return s;
   };
-  std::pair<int, double> best{0, 0.0};
+  Support best;
   size_t best_i = 0, best_j = 0;
   for (size_t i = 0; i < positions.size(); ++i)
     for (size_t j = i + 1; j < positions.size(); ++j) {
@@ -59,10 +71,10 @@ std::optional<SpeedFit> fitSpeedAmongOutliers(const std::vector<TimedPosition>& 
       // one box of each and a third within the far boxes' gate said 10 m/s sideways).
       const Eigen::Vector2d d = (positions[j].p - positions[i].p).head<2>();
       if (heading && std::abs(heading->x() * d.y() - heading->y() * d.x()) > gate) continue;
-      const auto [n, cost] = inliers(i, j, nullptr);
-      if (n > best.first || (n == best.first && cost < best.second)) best = {n, cost}, best_i = i, best_j = j;
+      const Support s = inliers(i, j, nullptr);
+      if (s.betterThan(best)) best = s, best_i = i, best_j = j;
     }
-  if (best.first < 2) return fitSpeed(positions, position_sigma);
+  if (best.n < 2) return fitSpeed(positions, position_sigma);
   std::vector<TimedPosition> kept;
   inliers(best_i, best_j, &kept);
   return fitSpeed(kept, position_sigma);

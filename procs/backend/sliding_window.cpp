@@ -461,13 +461,12 @@ void SlidingWindow::addTrackObservation(Track& track, int frame) {
     sigma.head<3>() *= growth;
     return sigma;
   };
+  const Matrix6 S = sqrtInformation(sigmas(config_.boxSigma(track.type, track.model != TrackModel::kStatic)));
   if (track.model == TrackModel::kStatic) {
-    addFactor(LandmarkObservationFactor::Create(obs.b, sqrtInformation(sigmas(config_.boxSigma(track.type, false)))), true,
-              {x, track.landmark->data()});
+    addFactor(LandmarkObservationFactor::Create(obs.b, S), true, {x, track.landmark->data()});
   } else {
     extendChain(track, frame, X * obs.b);
-    addFactor(ObservationFactor::Create(obs.b, sqrtInformation(sigmas(config_.boxSigma(track.type, true)))), true,
-              {x, track.poses.at(frame)->data()});
+    addFactor(ObservationFactor::Create(obs.b, S), true, {x, track.poses.at(frame)->data()});
   }
   obs.in_graph = true;
 }
@@ -749,7 +748,8 @@ SmoothedPose SlidingWindow::slide() {
   for (auto& [id, track] : tracks_) {
     if (isVehicle(track.type)) continue;
     if (const auto it = track.observations.find(s); it != track.observations.end())
-      track.past_boxes.push_back({1e-6 * static_cast<double>(oldest.utime), smoothed.pose * it->second.b.translation()});
+      track.past_boxes.push_back(
+          {1e-6 * static_cast<double>(oldest.utime), smoothed.pose * it->second.b.translation()});
     while (!track.past_boxes.empty() && newest - track.past_boxes.front().t > config_.walker_line_span_s)
       track.past_boxes.pop_front();
   }

@@ -38,6 +38,12 @@ std::optional<SpeedFit> fitSpeedAmongOutliers(const std::vector<TimedPosition>& 
 // with that component replaced by the variance-weighted mean of the two.
 Eigen::Vector3d velocityAlongHeading(const SpeedFit& fit, const Eigen::Vector2d& heading, double heading_sigma);
 
+// Evidence of motion: a speed above `min_speed` and above `min_sigmas` standard deviations of it
+// (box noise alone makes a still object's fitted speed a sigma or so).
+inline bool movesBeyond(double speed, double sigma, double min_speed, double min_sigmas) {
+  return speed > min_speed && speed > min_sigmas * sigma;
+}
+
 // True when the last `n` positions all lie farther than `distance` (bird's-eye) from `landmark`
 // (false when there are fewer than n).
 bool leftLandmark(const std::vector<Eigen::Vector3d>& positions, const Eigen::Vector3d& landmark, double distance,

@@ -432,7 +432,7 @@ void SlidingWindow::startTrack(Track& track, int frame) {
   // Static or dynamic from the positions of the trajectory in the window (III-D); the tracker's
   // guess only when the window has too little of it.
   const auto moving = [&](double speed, double sigma) {
-    return speed > config_.static_max_speed && speed > config_.dynamic_min_sigmas * sigma;
+    return movesBeyond(speed, sigma, config_.static_max_speed, config_.dynamic_min_sigmas);
   };
   const std::optional<SpeedFit> fit = windowMotion(track, boxHeading(track));
   bool dynamic = fit ? moving(fit->speed, fit->sigma) : track.dynamic_guess;
@@ -523,7 +523,7 @@ int SlidingWindow::switchMovingLandmarks() {
     // seldom leaves its landmark by switch_distance, as the landmark follows its boxes.
     if (!moved && !isVehicle(track.type) && config_.walker_switch_min_sigmas > 0)
       if (const std::optional<SpeedFit> fit = windowMotion(track, std::nullopt))
-        moved = fit->speed > config_.static_max_speed && fit->speed > config_.walker_switch_min_sigmas * fit->sigma;
+        moved = movesBeyond(fit->speed, fit->sigma, config_.static_max_speed, config_.walker_switch_min_sigmas);
     if (moved) {
       makeDynamic(track);
       ++switched;
@@ -746,7 +746,10 @@ SmoothedPose SlidingWindow::slide() {
   // longer than the window lasts; the config says how long, measured on KITTI).
   const double newest = 1e-6 * static_cast<double>(frames_.back().utime);
   for (auto& [id, track] : tracks_) {
-    if (isVehicle(track.type)) continue;
+    if (isVehicle(track.type)) {  // (a track re-labelled a cyclist keeps no walker's boxes)
+      track.past_boxes.clear();
+      continue;
+    }
     if (const auto it = track.observations.find(s); it != track.observations.end())
       track.past_boxes.push_back(
           {1e-6 * static_cast<double>(oldest.utime), smoothed.pose * it->second.b.translation()});

@@ -74,7 +74,7 @@ class SlidingWindow {
     std::map<int, Block> changes;   // dynamic: frame f -> c_f^{f+1}
     std::map<int, Observation> observations;  // frames in the window
     // A walker's boxes that left the window (world, the ego pose as estimated when they left),
-    // within walker_line_span_s of the window's oldest frame.
+    // within walker_line_span_s of the newest frame.
     std::deque<TimedPosition> past_boxes;
     // The motion last estimated (world frame): kept while the window holds too little of the
     // chain to estimate it again (coasting, or about to leave).

@@ -1,5 +1,6 @@
-// The objects' classes: realistic sizes (KITTI label statistics) and solid shapes inside the
-// labelled box, so the box a label gives is the box the points come from.
+// The objects' classes: realistic sizes (KITTI label statistics) and solid shapes in the labelled
+// box: a vehicle's body stands on wheels in arches, and only its mirrors reach out of the box, as
+// KITTI's boxes leave them out.
 #pragma once
 
 #include <Eigen/Core>
@@ -10,6 +11,9 @@
 #include "solid.hpp"
 
 namespace dlslot::sim {
+
+// How far an object's parts reach outside its labelled box (a truck's mirrors), metres.
+constexpr double kPartsOutsideBoxM = 0.25;
 
 // Box size (l, w, h) of a random member of the class ("Car", "Van", "Truck", "Cyclist", "Pedestrian").
 Eigen::Vector3d sampleSize(const std::string& type, Rng& rng);

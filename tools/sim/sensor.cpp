@@ -7,6 +7,7 @@
 #include <string>
 #include <thread>
 
+#include "object_shape.hpp"
 #include "rng.hpp"
 
 namespace dlslot::sim {
@@ -40,7 +41,7 @@ std::vector<std::vector<int>> azimuthBuckets(const ScanInput& in, int columns, d
     const Box& b = in.object_boxes[i];
     const Eigen::Vector3d c = T_lidar_map * b.center;
     const double v = in.object_velocity.empty() ? 0.0 : in.object_velocity[i].norm();
-    const double radius = 0.5 * b.size.norm() + 0.05 + half_sweep_s * (v + in.ego.velocity.norm());
+    const double radius = 0.5 * b.size.norm() + kPartsOutsideBoxM + 0.05 + half_sweep_s * (v + in.ego.velocity.norm());
     const double rho = c.head<2>().norm();
     if (rho - radius > max_range) continue;
     if (rho <= radius) {
@@ -102,9 +103,14 @@ Scan scan(const SensorSpec& sensor, const ScanInput& in, int threads) {
   const double step = 2 * M_PI / columns;
   const int extra = 2 + static_cast<int>(std::ceil((in.ego.omega.norm() * max_t + max_az_error) / step));
   const auto buckets = azimuthBuckets(in, columns, sensor.max_range_m, max_t, extra);
-  // Object boxes as solids, for the rays-through-box counts.
-  std::vector<Solid> box_solids;
-  for (const Box& b : in.object_boxes) box_solids.push_back(Solid::box(b.center, b.size, b.yaw, 0.0f));
+  // Object boxes as solids, for the rays-through-box counts; grown by what reaches out of them
+  // (mirrors), the rays that may meet the object's parts.
+  std::vector<Solid> box_solids, reach_solids;
+  const Eigen::Vector3d reach(2 * kPartsOutsideBoxM, 2 * kPartsOutsideBoxM, 0.0);
+  for (const Box& b : in.object_boxes) {
+    box_solids.push_back(Solid::box(b.center, b.size, b.yaw, 0.0f));
+    reach_solids.push_back(Solid::box(b.center, b.size + reach, b.yaw, 0.0f));
+  }
   // Each object's parts: indices into object_solids.
   std::vector<std::vector<int>> parts(in.object_boxes.size());
   for (size_t k = 0; k < in.object_solids.size(); ++k) parts[in.object_solids[k].owner].push_back(static_cast<int>(k));
@@ -160,8 +166,8 @@ Scan scan(const SensorSpec& sensor, const ScanInput& in, int threads) {
           // i.e. the object at the reference time seen from an origin moved back by its motion.
           const Eigen::Vector3d o_obj = o - fired[a] * velocityOf(obj);
           double e;
-          if (!intersect(box_solids[obj], o_obj, d, sensor.max_range_m, e)) continue;
-          entered.emplace_back(obj, e);
+          if (!intersect(reach_solids[obj], o_obj, d, sensor.max_range_m, e)) continue;
+          if (intersect(box_solids[obj], o_obj, d, sensor.max_range_m, e)) entered.emplace_back(obj, e);
           for (int p : parts[obj])
             if (intersect(in.object_solids[p], o_obj, d, best, s)) {
               best = s;

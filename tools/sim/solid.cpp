@@ -37,7 +37,65 @@ Solid Solid::sphere(const Eigen::Vector3d& center, double radius, float reflecti
   return s;
 }
 
+Solid Solid::wheel(const Eigen::Vector3d& center, double radius, double width, double yaw, float reflectivity) {
+  Solid s;
+  s.kind = SolidKind::Wheel;
+  s.center = center;
+  s.half = Eigen::Vector3d(radius, 0.5 * width, radius);
+  s.cos_yaw = std::cos(yaw);
+  s.sin_yaw = std::sin(yaw);
+  s.reflectivity = reflectivity;
+  return s;
+}
+
 namespace {
+
+// A vector in the frame of a yawed solid: x along its heading, y to its left, z up.
+Eigen::Vector3d toLocal(const Solid& s, const Eigen::Vector3d& v) {
+  return {s.cos_yaw * v.x() + s.sin_yaw * v.y(), -s.sin_yaw * v.x() + s.cos_yaw * v.y(), v.z()};
+}
+Eigen::Vector3d fromLocal(const Solid& s, const Eigen::Vector3d& v) {
+  return {s.cos_yaw * v.x() - s.sin_yaw * v.y(), s.sin_yaw * v.x() + s.cos_yaw * v.y(), v.z()};
+}
+
+// The ray (o, d), relative to the axis' mid point, against a cylinder of radius r along z from
+// -hz to hz: its side and its two caps. Wheels use it with their axle as z.
+bool intersectAxialCylinder(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double r, double hz, double max_s,
+                            double& s) {
+  double best = max_s;
+  const double a = d.x() * d.x() + d.y() * d.y();
+  if (a > 1e-12) {  // the side
+    const double bh = o.x() * d.x() + o.y() * d.y();
+    const double cc = o.x() * o.x() + o.y() * o.y() - r * r;
+    const double disc = bh * bh - a * cc;
+    if (disc >= 0) {
+      const double t = (-bh - std::sqrt(disc)) / a;
+      if (t > 0 && t < best && std::abs(o.z() + t * d.z()) <= hz) best = t;
+    }
+  }
+  if (std::abs(d.z()) > 1e-12) {  // the caps
+    for (double cap : {hz, -hz}) {
+      const double t = (cap - o.z()) / d.z();
+      if (t > 0 && t < best) {
+        const double px = o.x() + t * d.x(), py = o.y() + t * d.y();
+        if (px * px + py * py <= r * r) best = t;
+      }
+    }
+  }
+  if (best >= max_s) return false;
+  s = best;
+  return true;
+}
+
+// The outward normal at p (relative to the axis' mid point) of that cylinder.
+Eigen::Vector3d axialCylinderNormal(const Eigen::Vector3d& p, double hz) {
+  if (std::abs(p.z()) >= hz - 1e-6) return Eigen::Vector3d(0, 0, p.z() > 0 ? 1.0 : -1.0);
+  const double n = p.head<2>().norm();
+  return n > 0 ? Eigen::Vector3d(p.x() / n, p.y() / n, 0.0) : Eigen::Vector3d::UnitX();
+}
+
+// A wheel's local frame with its axle (local y) as the third axis, and back: (x, z, y).
+Eigen::Vector3d swapYZ(const Eigen::Vector3d& v) { return {v.x(), v.z(), v.y()}; }
 
 bool intersectBox(const Solid& b, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double& s) {
   const double rx = o.x() - b.center.x(), ry = o.y() - b.center.y();
@@ -62,31 +120,12 @@ bool intersectBox(const Solid& b, const Eigen::Vector3d& o, const Eigen::Vector3
 }
 
 bool intersectCylinder(const Solid& c, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double& s) {
-  const double ox = o.x() - c.center.x(), oy = o.y() - c.center.y(), oz = o.z() - c.center.z();
-  const double r = c.half.x(), hz = c.half.z();
-  double best = max_s;
-  const double a = d.x() * d.x() + d.y() * d.y();
-  if (a > 1e-12) {  // the side
-    const double bh = ox * d.x() + oy * d.y();
-    const double cc = ox * ox + oy * oy - r * r;
-    const double disc = bh * bh - a * cc;
-    if (disc >= 0) {
-      const double t = (-bh - std::sqrt(disc)) / a;
-      if (t > 0 && t < best && std::abs(oz + t * d.z()) <= hz) best = t;
-    }
-  }
-  if (std::abs(d.z()) > 1e-12) {  // the caps
-    for (double cap : {hz, -hz}) {
-      const double t = (cap - oz) / d.z();
-      if (t > 0 && t < best) {
-        const double px = ox + t * d.x(), py = oy + t * d.y();
-        if (px * px + py * py <= r * r) best = t;
-      }
-    }
-  }
-  if (best >= max_s) return false;
-  s = best;
-  return true;
+  return intersectAxialCylinder(o - c.center, d, c.half.x(), c.half.z(), max_s, s);
+}
+
+bool intersectWheel(const Solid& w, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double& s) {
+  return intersectAxialCylinder(swapYZ(toLocal(w, o - w.center)), swapYZ(toLocal(w, d)), w.half.x(), w.half.y(),
+                                max_s, s);
 }
 
 bool intersectSphere(const Solid& sp, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_s, double& s) {
@@ -142,7 +181,7 @@ struct Footprint {
 Footprint footprintOf(const Solid& s, double grow) {
   Footprint f;
   f.c = s.center.head<2>();
-  if (s.kind != SolidKind::Box) {
+  if (s.kind != SolidKind::Box && s.kind != SolidKind::Wheel) {
     f.circle = true;
     f.r = s.half.x() + grow;
     return f;
@@ -179,6 +218,8 @@ bool intersect(const Solid& solid, const Eigen::Vector3d& o, const Eigen::Vector
       return intersectCylinder(solid, o, d, max_s, s);
     case SolidKind::Sphere:
       return intersectSphere(solid, o, d, max_s, s);
+    case SolidKind::Wheel:
+      return intersectWheel(solid, o, d, max_s, s);
   }
   return false;
 }
@@ -187,8 +228,7 @@ Eigen::Vector3d normalAt(const Solid& solid, const Eigen::Vector3d& p) {
   const Eigen::Vector3d r = p - solid.center;
   switch (solid.kind) {
     case SolidKind::Box: {
-      const Eigen::Vector3d local(solid.cos_yaw * r.x() + solid.sin_yaw * r.y(),
-                                  -solid.sin_yaw * r.x() + solid.cos_yaw * r.y(), r.z());
+      const Eigen::Vector3d local = toLocal(solid, r);
       int axis = 0;
       double best = -1;
       for (int i = 0; i < 3; ++i) {
@@ -200,15 +240,12 @@ Eigen::Vector3d normalAt(const Solid& solid, const Eigen::Vector3d& p) {
       }
       Eigen::Vector3d n_local = Eigen::Vector3d::Zero();
       n_local[axis] = local[axis] >= 0 ? 1.0 : -1.0;
-      return {solid.cos_yaw * n_local.x() - solid.sin_yaw * n_local.y(),
-              solid.sin_yaw * n_local.x() + solid.cos_yaw * n_local.y(), n_local.z()};
+      return fromLocal(solid, n_local);
     }
-    case SolidKind::Cylinder: {
-      if (std::abs(r.z()) >= solid.half.z() - 1e-6) return Eigen::Vector3d(0, 0, r.z() > 0 ? 1.0 : -1.0);
-      const Eigen::Vector2d radial = r.head<2>();
-      const double n = radial.norm();
-      return n > 0 ? Eigen::Vector3d(radial.x() / n, radial.y() / n, 0.0) : Eigen::Vector3d::UnitX();
-    }
+    case SolidKind::Cylinder:
+      return axialCylinderNormal(r, solid.half.z());
+    case SolidKind::Wheel:
+      return fromLocal(solid, swapYZ(axialCylinderNormal(swapYZ(toLocal(solid, r)), solid.half.y())));
     case SolidKind::Sphere: {
       const double n = r.norm();
       return n > 0 ? Eigen::Vector3d(r / n) : Eigen::Vector3d::UnitZ();
@@ -221,7 +258,8 @@ bool chord(const Solid& solid, const Eigen::Vector3d& o, const Eigen::Vector3d& 
   switch (solid.kind) {
     case SolidKind::Box: return chordBox(solid, o, d, s_in, s_out);
     case SolidKind::Sphere: return chordSphere(solid, o, d, s_in, s_out);
-    case SolidKind::Cylinder: return false;
+    case SolidKind::Cylinder:
+    case SolidKind::Wheel: return false;
   }
   return false;
 }

@@ -13,42 +13,10 @@ squares line through its boxes of the last S seconds (at least half of them pres
 velocity; the RMS and median of its error are printed per span S."""
 import collections, math, os, sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from kitti_frames import apply, camera_to_world  # noqa: E402
+
 SPANS = (1.0, 1.5, 2.0, 3.0)
-
-
-def mat(v):
-    return [v[0:4], v[4:8], v[8:12], [0, 0, 0, 1]]
-
-
-def mul(a, b):
-    return [[sum(a[i][k] * b[k][j] for k in range(4)) for j in range(4)] for i in range(4)]
-
-
-def inverse(t):
-    r = [[t[j][i] for j in range(3)] for i in range(3)]
-    p = [-sum(r[i][k] * t[k][3] for k in range(3)) for i in range(3)]
-    return [r[0] + [p[0]], r[1] + [p[1]], r[2] + [p[2]], [0, 0, 0, 1]]
-
-
-def apply(t, p):
-    return [sum(t[i][k] * p[k] for k in range(3)) + t[i][3] for i in range(2)]
-
-
-def camera_to_world(root, seq):
-    calib = {}
-    for line in open(os.path.join(root, "training", "calib", seq + ".txt")):
-        t = line.replace(":", " ").split()
-        if t:
-            calib[t[0]] = [float(x) for x in t[1:]]
-    r = calib.get("R_rect", calib.get("R0_rect"))
-    rect = [r[0:3] + [0], r[3:6] + [0], r[6:9] + [0], [0, 0, 0, 1]]
-    cam_to_velo = inverse(mul(rect, mat(calib.get("Tr_velo_cam", calib.get("Tr_velo_to_cam")))))
-    path = os.path.join(root, "poses", seq + ".txt")
-    if not os.path.exists(path):
-        print(f"{seq}: no poses, taken as seen from a parked sensor")
-        return lambda f: cam_to_velo
-    poses = [mat([float(x) for x in line.split()]) for line in open(path)]
-    return lambda f: mul(poses[f], cam_to_velo)
 
 
 def main():

@@ -646,4 +646,6 @@ TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
   expectRefused("walker_line_span_s", "-1");
   EXPECT_EQ(c.walker_switch_min_sigmas, 3.0);
   expectRefused("walker_switch_min_sigmas", "-1");
+  EXPECT_EQ(c.vehicle_lateral_acceleration, 1.0);
+  for (const char* bad : {"-1", "fast"}) expectRefused("vehicle_lateral_acceleration", bad);
 }

@@ -487,6 +487,18 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
     double* change = newBlock(track.changes[f - 1], fromBlock(prev).inverse() * o_f);  // eq. 2
     addFactor(PoseChangeFactor::Create(sqrtInformation(config_.pose_change_sigma)), false, {prev, cur, change});
     if (isVehicle(track.type)) addFactor(VehicleMotionFactor::Create(config_.vehicle_motion_sigma), false, {change});
+    if (isVehicle(track.type) && track.changes.size() == 1 && config_.vehicle_lateral_acceleration > 0) {
+      // Its speed: the track's velocity when it has one, else this first change's.
+      const EgoFrame *a = findFrame(f - 1), *b = findFrame(f);
+      const double dt = a && b ? 1e-6 * static_cast<double>(b->utime - a->utime) : 0.0;
+      if (dt > 0) {
+        const double speed = track.velocity ? track.velocity->head<2>().norm()
+                                            : (o_f.translation() - fromBlock(prev).translation()).head<2>().norm() / dt;
+        // Below 1 m/s a vehicle may turn on the spot as far as this prior is concerned.
+        const double sigma_rz = config_.vehicle_lateral_acceleration * dt / std::max(speed, 1.0);
+        addFactor(VehicleMotionFactor::StartingStraight(sigma_rz), false, {change});
+      }
+    }
     // The object's points measured how it moved against the sensor between f - 1 and f (robust: a
     // wrong association registers two objects' points).
     const auto m = track.motions.find(f);

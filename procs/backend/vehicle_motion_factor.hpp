@@ -23,6 +23,16 @@ class VehicleMotionFactor final : public PoseFactor {
     S(4, 4) = 1.0 / sigmas[3];
     return new VehicleMotionFactor(S);
   }
+  // A vehicle whose chain starts with this pose change starts straight: c's yaw is zero-mean with
+  // sigma_rz (rad a frame). Its boxes' headings (0.04 rad each) measure the yaw rate of a young
+  // chain only to ~0.004 rad a frame over the window, and left free that rate carries the newest
+  // heading, and with it the velocity's direction, ~1 deg off at the window's end; a vehicle
+  // turns at the lateral acceleration a at speed v with yaw rate a / v, which bounds it.
+  static ceres::CostFunction* StartingStraight(double sigma_rz) {
+    Matrix6 S = Matrix6::Zero();
+    S(5, 5) = 1.0 / sigma_rz;
+    return new VehicleMotionFactor(S);
+  }
 
  protected:
   // Parameter: c_{t-1}^t. The error is c itself ([t; Log R] of B^-1 A Z with A = c, B = Z = I).

@@ -1,0 +1,42 @@
+"""KITTI tracking frames for the analysis scripts: 4x4 transforms as nested lists, and the
+transform from a sequence's rectified camera-0 coordinates (its labels) to the world of its
+velodyne poses (ROOT/poses/SSSS.txt as in AB3DMOT's data, or ROOT/training/poses/SSSS.txt as the
+simulator writes them)."""
+import os
+
+
+def mat(v):
+    return [v[0:4], v[4:8], v[8:12], [0, 0, 0, 1]]
+
+
+def mul(a, b):
+    return [[sum(a[i][k] * b[k][j] for k in range(4)) for j in range(4)] for i in range(4)]
+
+
+def inverse(t):
+    r = [[t[j][i] for j in range(3)] for i in range(3)]
+    p = [-sum(r[i][k] * t[k][3] for k in range(3)) for i in range(3)]
+    return [r[0] + [p[0]], r[1] + [p[1]], r[2] + [p[2]], [0, 0, 0, 1]]
+
+
+def apply(t, p):
+    return [sum(t[i][k] * p[k] for k in range(3)) + t[i][3] for i in range(2)]
+
+
+def camera_to_world(root, seq):
+    calib = {}
+    for line in open(os.path.join(root, "training", "calib", seq + ".txt")):
+        t = line.replace(":", " ").split()
+        if t:
+            calib[t[0]] = [float(x) for x in t[1:]]
+    r = calib.get("R_rect", calib.get("R0_rect"))
+    rect = [r[0:3] + [0], r[3:6] + [0], r[6:9] + [0], [0, 0, 0, 1]]
+    cam_to_velo = inverse(mul(rect, mat(calib.get("Tr_velo_cam", calib.get("Tr_velo_to_cam")))))
+    path = os.path.join(root, "poses", seq + ".txt")
+    if not os.path.exists(path):  # a simulated sequence keeps them under training/
+        path = os.path.join(root, "training", "poses", seq + ".txt")
+    if not os.path.exists(path):
+        print(f"{seq}: no poses, taken as seen from a parked sensor")
+        return lambda f: cam_to_velo
+    poses = [mat([float(x) for x in line.split()]) for line in open(path)]
+    return lambda f: mul(poses[f], cam_to_velo)

@@ -1,0 +1,95 @@
+#!/usr/bin/env python3
+"""How fast moving vehicles turn: their yaw rate and lateral acceleration, from labels.
+
+usage: scripts/vehicle-yaw-rates.py KITTI_DIR [SEQUENCE...]   (default: every sequence with poses)
+KITTI_DIR holds training/label_02, training/calib and the velodyne poses (poses/SSSS.txt, e.g.
+../shared/data/kitti-tracking-mot-train, or training/poses/SSSS.txt as the simulator writes them).
+For every labelled Car, Van and Truck and every frame with labels 0.5 s before and after, the
+speed is the central difference of its world centres and the yaw rate that of its world heading
+(the box's, taken modulo pi: a label turned round is not a turn), both over +-0.5 s; the lateral
+acceleration is their product. Printed for vehicles faster than 2 m/s (slower, the poses' 0.1-
+0.15 m jitter is a large part of the motion): RMS and percentiles of |yaw rate| and |lateral
+acceleration|, and the RMS of the yaw rate in speed bands."""
+import collections, math, os, sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from kitti_frames import apply, camera_to_world  # noqa: E402
+
+VEHICLES = ("Car", "Van", "Truck")
+HALF = 5  # frames: +-0.5 s at 10 Hz
+
+
+def heading(to_world, ry):
+    # A camera label's forward axis is (cos ry, 0, -sin ry) in camera coordinates.
+    o = apply(to_world, [0.0, 0.0, 0.0])
+    p = apply(to_world, [math.cos(ry), 0.0, -math.sin(ry)])
+    return math.atan2(p[1] - o[1], p[0] - o[0])
+
+
+def modulo_pi(a):
+    return (a + math.pi / 2) % math.pi - math.pi / 2
+
+
+def sequences_with_poses(root):
+    names = set()
+    for d in (os.path.join(root, "poses"), os.path.join(root, "training", "poses")):
+        if os.path.isdir(d):
+            names.update(f[:-4] for f in os.listdir(d) if f.endswith(".txt"))
+    return sorted(names)
+
+
+def percentile(v, q):
+    return v[min(len(v) - 1, int(q * len(v)))]
+
+
+def main():
+    if len(sys.argv) < 2:
+        sys.exit(__doc__)
+    root = sys.argv[1]
+    sequences = sys.argv[2:] or sequences_with_poses(root)
+    if not sequences:
+        sys.exit(f"{root}: no poses/SSSS.txt or training/poses/SSSS.txt")
+    rates, lateral = [], []
+    by_speed = collections.defaultdict(list)
+    for seq in sequences:
+        to_world = camera_to_world(root, seq)
+        tracks = collections.defaultdict(dict)  # id -> frame -> (x, y, heading)
+        path = os.path.join(root, "training", "label_02", seq + ".txt")
+        for n, line in enumerate(open(path), 1):
+            t = line.split()
+            if len(t) < 17:
+                sys.exit(f"{path}:{n}: expected 17 fields, got {len(t)}")
+            if t[2] in VEHICLES:
+                f = int(t[0])
+                p = apply(to_world(f), [float(t[13]), float(t[14]), float(t[15])])
+                tracks[int(t[1])][f] = (p[0], p[1], heading(to_world(f), float(t[16])))
+        for track in tracks.values():
+            for f in track:
+                if f - HALF not in track or f + HALF not in track:
+                    continue
+                a, b = track[f - HALF], track[f + HALF]
+                span = 2 * HALF * 0.1
+                speed = math.hypot(b[0] - a[0], b[1] - a[1]) / span
+                if speed < 2.0:
+                    continue
+                rate = modulo_pi(b[2] - a[2]) / span
+                rates.append(abs(rate))
+                lateral.append(abs(rate) * speed)
+                by_speed[min(int(speed // 5) * 5, 20)].append(rate)
+    if not rates:
+        sys.exit("no moving vehicle with labels +-0.5 s around a frame")
+    rms = lambda v: math.sqrt(sum(x * x for x in v) / len(v))
+    rates.sort()
+    lateral.sort()
+    print(f"{len(rates)} frames of moving vehicles in {len(sequences)} sequences")
+    print(f"yaw rate rad/s: RMS {rms(rates):.3f}, median {percentile(rates, 0.5):.3f}, "
+          f"p90 {percentile(rates, 0.9):.3f}, p99 {percentile(rates, 0.99):.3f}")
+    print(f"lateral acceleration m/s^2: RMS {rms(lateral):.3f}, median {percentile(lateral, 0.5):.3f}, "
+          f"p90 {percentile(lateral, 0.9):.3f}, p99 {percentile(lateral, 0.99):.3f}")
+    for lo in sorted(by_speed):
+        hi = "" if lo == 20 else f"-{lo + 5}"
+        print(f"  speed {lo}{hi or '+'} m/s: {len(by_speed[lo])} frames, yaw rate RMS {rms(by_speed[lo]):.3f} rad/s")
+
+
+if __name__ == "__main__":
+    main()

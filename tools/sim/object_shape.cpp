@@ -61,6 +61,23 @@ void mirrors(std::vector<Solid>& out, double x, double w, double zc, double heig
                              Eigen::Vector3d(0.1, reach + 0.02, height), 0.0, refl));
 }
 
+// A car's or van's body above its wheels: its top (a fraction of the height), the glass cabin on
+// it from x0 to x1 (fractions of the length) and its width (a fraction of the body's), and the
+// mirrors at the cabin's front: their centre above the body's top, height and reach.
+struct Body {
+  double top, cabin_x0, cabin_x1, cabin_width, mirror_above, mirror_height, mirror_reach;
+};
+
+std::vector<Solid> carLike(double l, double w, double h, const Wheels& wh, const Body& b, float refl) {
+  const double bottom = -0.5 * h;
+  std::vector<Solid> out;
+  bodyOnWheels(out, -0.5 * l, 0.5 * l, w, 0.15, b.top * h, wh, w - 2 * (wh.width + 0.05), bottom, refl);
+  tyres(out, wh, w, bottom);
+  out.push_back(part(b.cabin_x0 * l, b.cabin_x1 * l, b.cabin_width * w, b.top * h, h, bottom, 0.5f * refl));  // glass
+  mirrors(out, b.cabin_x1 * l - 0.1, w, b.top * h + b.mirror_above, b.mirror_height, b.mirror_reach, bottom, refl);
+  return out;
+}
+
 }  // namespace
 
 bool isVehicle(const std::string& type) { return type == "Car" || type == "Van" || type == "Truck"; }
@@ -78,25 +95,16 @@ Eigen::Vector3d sampleSize(const std::string& type, Rng& rng) {
 
 std::vector<Solid> objectParts(const std::string& type, const Eigen::Vector3d& size, float refl) {
   const double l = size.x(), w = size.y(), h = size.z(), bottom = -0.5 * h;
-  const float glass = 0.5f * refl;  // windows return weaker
-  std::vector<Solid> out;
-  if (type == "Car") {  // body to 58 % of the height, a shorter and narrower cabin on top
-    const Wheels wh{0.31, 0.2, 0.01, {-0.5 * l + 0.8, 0.5 * l - 0.85}};
-    bodyOnWheels(out, -0.5 * l, 0.5 * l, w, 0.15, 0.58 * h, wh, w - 2 * (wh.width + 0.05), bottom, refl);
-    tyres(out, wh, w, bottom);
-    out.push_back(part(-0.36 * l, 0.2 * l, 0.9 * w, 0.58 * h, h, bottom, glass));
-    mirrors(out, 0.2 * l - 0.1, w, 0.58 * h + 0.1, 0.12, 0.12, bottom, refl);
-    return out;
-  }
-  if (type == "Van") {
-    const Wheels wh{0.34, 0.22, 0.01, {-0.5 * l + 1.0, 0.5 * l - 0.9}};
-    bodyOnWheels(out, -0.5 * l, 0.5 * l, w, 0.15, 0.62 * h, wh, w - 2 * (wh.width + 0.05), bottom, refl);
-    tyres(out, wh, w, bottom);
-    out.push_back(part(-0.5 * l, 0.36 * l, 0.97 * w, 0.62 * h, h, bottom, glass));
-    mirrors(out, 0.36 * l - 0.1, w, 0.62 * h + 0.12, 0.2, 0.15, bottom, refl);
-    return out;
-  }
+  // A car: body to 58 % of the height, a shorter and narrower glass cabin on top; a van: a body
+  // to 62 % and a cabin to its back.
+  if (type == "Car")
+    return carLike(l, w, h, {0.31, 0.2, 0.01, {-0.5 * l + 0.8, 0.5 * l - 0.85}}, {0.58, -0.36, 0.2, 0.9, 0.1, 0.12, 0.12},
+                   refl);
+  if (type == "Van")
+    return carLike(l, w, h, {0.34, 0.22, 0.01, {-0.5 * l + 1.0, 0.5 * l - 0.9}}, {0.62, -0.5, 0.36, 0.97, 0.12, 0.2, 0.15},
+                   refl);
   if (type == "Truck") {  // chassis, cab in front, cargo box behind; a tandem rear axle on long ones
+    std::vector<Solid> out;
     Wheels wh{0.5, 0.3, 0.03, {-0.5 * l + 1.6, 0.5 * l - 1.2}};
     if (l >= 9.0) wh.axles.insert(wh.axles.begin() + 1, -0.5 * l + 2.9);
     out.push_back(part(-0.5 * l, 0.5 * l, 0.9 * w, 0.4, 1.0, bottom, 0.3f));

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""How fast moving vehicles turn: their yaw rate and lateral acceleration, from labels.
+"""How fast moving vehicles turn and brake: yaw rate, lateral and longitudinal acceleration, from labels.
 
 usage: scripts/vehicle-yaw-rates.py KITTI_DIR [SEQUENCE...]   (default: every sequence with poses)
 KITTI_DIR holds training/label_02, training/calib and the velodyne poses (poses/SSSS.txt, e.g.
@@ -49,7 +49,7 @@ def main():
     sequences = sys.argv[2:] or sequences_with_poses(root)
     if not sequences:
         sys.exit(f"{root}: no poses/SSSS.txt or training/poses/SSSS.txt")
-    rates, lateral = [], []
+    rates, lateral, longitudinal = [], [], []
     by_speed = collections.defaultdict(list)
     for seq in sequences:
         to_world = camera_to_world(root, seq)
@@ -73,6 +73,10 @@ def main():
                 if speed < 2.0:
                     continue
                 rate = modulo_pi(b[2] - a[2]) / span
+                if all(f + k in track for k in (-2 * HALF, 2 * HALF)):
+                    speed_at = lambda c: math.hypot(track[c + HALF][0] - track[c - HALF][0],
+                                                    track[c + HALF][1] - track[c - HALF][1]) / span
+                    longitudinal.append(abs(speed_at(f + HALF) - speed_at(f - HALF)) / span)
                 rates.append(abs(rate))
                 lateral.append(abs(rate) * speed)
                 by_speed[min(int(speed // 5) * 5, 20)].append(rate)
@@ -86,6 +90,11 @@ def main():
           f"p90 {percentile(rates, 0.9):.3f}, p99 {percentile(rates, 0.99):.3f}")
     print(f"lateral acceleration m/s^2: RMS {rms(lateral):.3f}, median {percentile(lateral, 0.5):.3f}, "
           f"p90 {percentile(lateral, 0.9):.3f}, p99 {percentile(lateral, 0.99):.3f}")
+    if longitudinal:
+        longitudinal.sort()
+        print(f"longitudinal acceleration m/s^2 ({len(longitudinal)} frames): RMS {rms(longitudinal):.3f}, "
+              f"median {percentile(longitudinal, 0.5):.3f}, p90 {percentile(longitudinal, 0.9):.3f}, "
+              f"p99 {percentile(longitudinal, 0.99):.3f}")
     for lo in sorted(by_speed):
         hi = "" if lo == 20 else f"-{lo + 5}"
         print(f"  speed {lo}{hi or '+'} m/s: {len(by_speed[lo])} frames, yaw rate RMS {rms(by_speed[lo]):.3f} rad/s")

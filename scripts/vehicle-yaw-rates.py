@@ -17,6 +17,13 @@ from kitti_frames import apply, camera_to_world  # noqa: E402
 
 VEHICLES = ("Car", "Van", "Truck")
 HALF = 5  # frames: +-0.5 s at 10 Hz
+SPAN = 2 * HALF * 0.1  # s
+
+
+def speed_at(track, f):
+    """The speed at frame f: the central difference of the centres HALF frames either side."""
+    a, b = track[f - HALF], track[f + HALF]
+    return math.hypot(b[0] - a[0], b[1] - a[1]) / SPAN
 
 
 def heading(to_world, ry):
@@ -67,16 +74,12 @@ def main():
             for f in track:
                 if f - HALF not in track or f + HALF not in track:
                     continue
-                a, b = track[f - HALF], track[f + HALF]
-                span = 2 * HALF * 0.1
-                speed = math.hypot(b[0] - a[0], b[1] - a[1]) / span
+                speed = speed_at(track, f)
                 if speed < 2.0:
                     continue
-                rate = modulo_pi(b[2] - a[2]) / span
-                if all(f + k in track for k in (-2 * HALF, 2 * HALF)):
-                    speed_at = lambda c: math.hypot(track[c + HALF][0] - track[c - HALF][0],
-                                                    track[c + HALF][1] - track[c - HALF][1]) / span
-                    longitudinal.append(abs(speed_at(f + HALF) - speed_at(f - HALF)) / span)
+                rate = modulo_pi(track[f + HALF][2] - track[f - HALF][2]) / SPAN
+                if f - 2 * HALF in track and f + 2 * HALF in track:
+                    longitudinal.append(abs(speed_at(track, f + HALF) - speed_at(track, f - HALF)) / SPAN)
                 rates.append(abs(rate))
                 lateral.append(abs(rate) * speed)
                 by_speed[min(int(speed // 5) * 5, 20)].append(rate)

@@ -487,18 +487,8 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
     double* change = newBlock(track.changes[f - 1], fromBlock(prev).inverse() * o_f);  // eq. 2
     addFactor(PoseChangeFactor::Create(sqrtInformation(config_.pose_change_sigma)), false, {prev, cur, change});
     if (isVehicle(track.type)) addFactor(VehicleMotionFactor::Create(config_.vehicle_motion_sigma), false, {change});
-    if (isVehicle(track.type) && track.changes.size() == 1 && config_.vehicle_lateral_acceleration > 0) {
-      // Its speed: the track's velocity when it has one, else this first change's.
-      const EgoFrame *a = findFrame(f - 1), *b = findFrame(f);
-      const double dt = a && b ? 1e-6 * static_cast<double>(b->utime - a->utime) : 0.0;
-      if (dt > 0) {
-        const double speed = track.velocity ? track.velocity->head<2>().norm()
-                                            : (o_f.translation() - fromBlock(prev).translation()).head<2>().norm() / dt;
-        // Below 1 m/s a vehicle may turn on the spot as far as this prior is concerned.
-        const double sigma_rz = config_.vehicle_lateral_acceleration * dt / std::max(speed, 1.0);
-        addFactor(VehicleMotionFactor::StartingStraight(sigma_rz), false, {change});
-      }
-    }
+    if (isVehicle(track.type) && track.changes.size() == 1)
+      startStraight(track, f, change, o_f.translation() - fromBlock(prev).translation());
     // The object's points measured how it moved against the sensor between f - 1 and f (robust: a
     // wrong association registers two objects' points).
     const auto m = track.motions.find(f);
@@ -518,6 +508,16 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
       addFactor(ConstantAccelerationFactor::Create(config_.constant_acceleration_sigma), false,
                 {before2->second->data(), before->second->data(), change});
   }
+}
+
+void SlidingWindow::startStraight(const Track& track, int f, double* change, const Eigen::Vector3d& displacement) {
+  const double dt = secondsBetween(f - 1, f);
+  if (config_.vehicle_lateral_acceleration <= 0 || !(dt > 0)) return;
+  // Its speed: the track's velocity when it has one, else this first change's. Below 1 m/s a
+  // vehicle may turn on the spot as far as this prior is concerned.
+  const double speed = track.velocity ? track.velocity->head<2>().norm() : displacement.head<2>().norm() / dt;
+  const double sigma_rz = config_.vehicle_lateral_acceleration * dt / std::max(speed, 1.0);
+  addFactor(VehicleMotionFactor::StartingStraight(sigma_rz), false, {change});
 }
 
 // ---- step 3: a landmark that moves becomes a dynamic object ----
@@ -639,8 +639,7 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
       if (track.changes.size() >= 2) {
         // Angular velocity from the latest pose change c_f^{f+1} = o_f^-1 o_{f+1} over its time.
         const auto& [f, c_block] = *track.changes.rbegin();
-        const EgoFrame *a = findFrame(f), *b = findFrame(f + 1);
-        const double dt = a && b ? 1e-6 * static_cast<double>(b->utime - a->utime) : 0.0;
+        const double dt = secondsBetween(f, f + 1);
         if (dt > 0) {
           const Eigen::Matrix3d R_f = fromBlock(track.poses.at(f)->data()).linear();
           const Vector6 c = logPose(fromBlock(c_block->data()));
@@ -666,8 +665,7 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
         const auto last = track.poses.rbegin();
         auto first = last;
         for (int i = 0; i < config_.velocity_frames && std::next(first) != track.poses.rend(); ++i) ++first;
-        const EgoFrame *fa = findFrame(first->first), *fb = findFrame(last->first);
-        const double span = fa && fb ? 1e-6 * static_cast<double>(fb->utime - fa->utime) : 0.0;
+        const double span = secondsBetween(first->first, last->first);
         if (span > 0) {
           track.velocity = (fromBlock(last->second->data()).translation() - fromBlock(first->second->data()).translation()) / span;
           track.velocity_from_chain = true;
@@ -832,6 +830,11 @@ const SlidingWindow::EgoFrame* SlidingWindow::findFrame(int frame) const {
   for (const EgoFrame& f : frames_)
     if (f.frame == frame) return &f;
   return nullptr;
+}
+
+double SlidingWindow::secondsBetween(int f0, int f1) const {
+  const EgoFrame *a = findFrame(f0), *b = findFrame(f1);
+  return a && b ? 1e-6 * static_cast<double>(b->utime - a->utime) : 0.0;
 }
 
 Pose SlidingWindow::alignedBox(const Track& track, const Pose& X, const Box& box) const {

@@ -147,6 +147,9 @@ class SlidingWindow {
   std::optional<SpeedFit> windowMotion(const Track& track, const std::optional<BoxHeading>& heading) const;
   void addTrackObservation(Track& track, int frame);
   void extendChain(Track& track, int frame, const Pose& o);
+  // The prior that starts a vehicle's chain straight on its first pose change c_{f-1}^f, which
+  // moved it by `displacement` (world), at the track's speed (vehicle_motion_factor.hpp).
+  void startStraight(const Track& track, int f, double* change, const Eigen::Vector3d& displacement);
   int switchMovingLandmarks();
   void makeDynamic(Track& track);
   void solve(BackendOutput& out);
@@ -158,6 +161,8 @@ class SlidingWindow {
   void marginalizeBlocks(const std::unordered_set<const double*>& leaving);
   double* newBlock(Block& slot, const Pose& value);
   const EgoFrame* findFrame(int frame) const;
+  // Seconds from window frame f0 to f1; 0 when either has left the window.
+  double secondsBetween(int f0, int f1) const;
   bool isVehicle(const std::string& type) const;
   Pose alignedBox(const Track& track, const Pose& X, const Box& box) const;
   std::optional<Pose> predictedPose(const Track& track) const;

@@ -21,6 +21,7 @@
 #include "backend/odometry_factor.hpp"
 #include "backend/pose_change_factor.hpp"
 #include "backend/registration_factor.hpp"
+#include "backend/sight_speed_factor.hpp"
 #include "backend/vehicle_motion_factor.hpp"
 #include "backend/pose_manifold.hpp"
 #include "backend_scene.hpp"
@@ -242,6 +243,40 @@ TEST(BackendFactors, RegistrationMeasuresTheObjectAgainstTheSensorNotTheWorld) {
   EXPECT_LT(residual(f, {toBlock(X1), toBlock(planarPose(2.1, 0, 0)), toBlock(o1), toBlock(planarPose(1.6, 0, 0))}).norm(),
             1e-6);
   EXPECT_NEAR(residual(f, {toBlock(X1), toBlock(planarPose(2.1, 0, 0)), toBlock(o1), toBlock(c)}).norm(), 0.1 * 100, 1e-6);
+}
+
+TEST(BackendFactors, SightSpeedResidualAndJacobians) {
+  std::mt19937 rng(14);
+  std::uniform_real_distribution<double> angle(-3.0, 3.0), dist(-0.5, 0.5);
+  for (int i = 0; i < 10; ++i) {
+    const Pose X1 = randomPose(rng), X2 = randomPose(rng), o1 = randomPose(rng), c = randomPose(rng, 1.0, 0.3);
+    const double a = angle(rng), offset = dist(rng);
+    const Eigen::Vector3d u(std::cos(a), std::sin(a), 0.0);
+    const double d = u.dot(o1.linear() * c.translation() - (X2.translation() - X1.translation()));
+    SightSpeedFactor f(u, d + offset, 0.1);
+    const std::vector<Vector7> blocks{toBlock(X1), toBlock(X2), toBlock(o1), toBlock(c)};
+    const Vector6 r = residual(f, blocks);
+    EXPECT_NEAR(r[0], -offset / 0.1, 1e-9);
+    EXPECT_LT(r.tail<5>().norm(), 1e-12);
+    expectJacobiansMatchNumeric(f, blocks);
+  }
+}
+
+TEST(BackendFactors, SightSpeedMeasuresTheFaceAgainstTheSensor) {
+  // A car 40 m ahead drives at 5 m/s, the ego at 7 m/s, 0.1 s apart: its face comes 0.2 m nearer.
+  // The ego and the car moved together by another 0.1 m change nothing; the car alone 0.1 m
+  // faster along the line of sight is 0.1 m off, across it nothing.
+  const Eigen::Vector3d u = Eigen::Vector3d::UnitX();
+  const Pose X1 = planarPose(0, 0, 0), X2 = planarPose(0.7, 0, 0), o1 = planarPose(40, 0, 0.05);
+  const Pose c = o1.inverse() * planarPose(40.5, 0, 0.05);
+  SightSpeedFactor f(u, -0.2, 1.0);
+  EXPECT_LT(residual(f, {toBlock(X1), toBlock(X2), toBlock(o1), toBlock(c)}).norm(), 1e-9);
+  EXPECT_LT(residual(f, {toBlock(X1), toBlock(planarPose(0.8, 0, 0)), toBlock(o1),
+                         toBlock(o1.inverse() * planarPose(40.6, 0, 0.05))}).norm(), 1e-9);
+  EXPECT_NEAR(residual(f, {toBlock(X1), toBlock(X2), toBlock(o1), toBlock(o1.inverse() * planarPose(40.6, 0, 0.05))})[0],
+              0.1, 1e-9);
+  EXPECT_NEAR(residual(f, {toBlock(X1), toBlock(X2), toBlock(o1), toBlock(o1.inverse() * planarPose(40.5, 0.3, 0.05))})[0],
+              0.0, 1e-9);
 }
 
 TEST(BackendFactors, ConstantVelocityResidualAndJacobians) {

@@ -161,6 +161,7 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   require(c.line_of_sight_pairs >= 0, s, "line_of_sight_pairs", "an integer >= 0 (0: not used)");
   s.get("line_of_sight_sigma", c.line_of_sight_sigma);
   require(c.line_of_sight_sigma > 0.0, s, "line_of_sight_sigma", "a speed > 0 (m/s)");
+  s.get("line_of_sight_chain", c.line_of_sight_chain);
   s.get("registration_ground_clearance", c.registration_ground_clearance);
   require(c.registration_ground_clearance >= 0.0, s, "registration_ground_clearance", "a distance >= 0 (m)");
   s.get("solver_threads", c.solver_threads);

@@ -96,6 +96,9 @@ struct BackendConfig {
   double line_of_sight_max_angle_deg = 10.0;  // the box's heading from the line of sight (facesTheSensor)
   int line_of_sight_pairs = 3;
   double line_of_sight_sigma = 0.3;
+  // Each pair also a factor on a vehicle's chain once it spans the window, for the frames no
+  // registration measured (sight_speed_factor.hpp).
+  bool line_of_sight_chain = true;
   // The scans' firing order, from the config's lidar section (LidarConfig): a registered object's
   // points are moved to the scan's reference instant (its pose's, its boxes') by the ego's motion
   // and the object's over the time from their firing. period 0: de-skewed scans.

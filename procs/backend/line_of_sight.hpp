@@ -45,6 +45,9 @@ std::optional<Eigen::Vector3d> lineOfSight(const ObjectPoints& points, const Eig
 struct SightSpeed {
   Eigen::Vector2d u = Eigen::Vector2d::UnitX();
   double speed = 0;
+  // The sensor's displacement along u between the two scans (m) in the ego poses the pair was
+  // measured with: speed x dt minus it is the face's motion against the sensor (sight_speed_factor.hpp).
+  double sensor_displacement = 0;
 };
 
 // The median of the pairs' speeds as a velocity measured along the newest pair's u alone, with

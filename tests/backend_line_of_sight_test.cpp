@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <cstdio>
 
 #include "backend/line_of_sight.hpp"
@@ -89,35 +90,51 @@ TEST(LineOfSight, TheMedianPairAlongTheNewestLineOfSightOnly) {
 
 namespace {
 
-// A young oncoming car 70 -> 55 m ahead at 25 m/s, its boxes as far off as the backend's noise
-// model says (0.105 m x (1 + 0.035 x 65 m) = 0.34 m, config/dlslot.yaml):
-// the RMS error of its published velocity over its young frames, with and without the line of
-// sight (its registrations held off by a point count no car reaches, so the line of sight is the
-// only measurement of its points).
-double youngVelocityError(int line_of_sight_pairs) {
-  SimScene scene;  // the ego stopped at the origin: the lidar frame is the world's
+// One car (id 1) whose boxes are box_noise off, seen by an ego at the origin unless told otherwise.
+SimScene oneCar(std::function<Pose(double)> pose, double box_noise) {
+  SimScene scene;
   SimObject car;
   car.id = 1;
   car.type = "Car";
   car.size = kCar;
-  car.pose = constantTwist(planarPose(70.0, 3.5, M_PI, -1.73 + 0.75), 25.0, 0.0);
+  car.pose = std::move(pose);
   car.dynamic_guess = true;
   scene.objects = {car};
-  scene.box_noise = Eigen::Vector3d(0.34, 0.34, 0.05);
+  scene.box_noise = Eigen::Vector3d(box_noise, box_noise, 0.05);
+  return scene;
+}
+
+// A backend whose only measurement of the car's points is the line of sight: its registrations
+// are held off by a point count no car reaches.
+BackendConfig lineOfSightOnly() {
   BackendConfig c;
   c.compute_covariance = false;
   c.observation_sigma_growth_per_m = 0.035;
   c.registration_types = {"Car"};
   c.registration.min_points = 100000;
+  return c;
+}
+
+// The car's points in this frame's scan (lidar frame).
+void scanTheCar(const SimScene& scene, BackendInput& in, std::mt19937& rng) {
+  const Pose car_in_lidar = scene.egoTruth(in.frame).inverse() * scene.objectTruth(1, in.frame);
+  for (ObservationInput& o : in.observations)
+    o.points = std::make_shared<const ObjectPoints>(scanBox(car_in_lidar, kCar, Eigen::Vector3d::Zero(), rng));
+}
+
+// A young oncoming car 70 -> 55 m ahead at 25 m/s, its boxes as far off as the backend's noise
+// model says (0.105 m x (1 + 0.035 x 65 m) = 0.34 m, config/dlslot.yaml), the ego stopped: the RMS
+// error of its published velocity over its young frames, with and without the line of sight.
+double youngVelocityError(int line_of_sight_pairs) {
+  const SimScene scene = oneCar(constantTwist(planarPose(70.0, 3.5, M_PI, -1.73 + 0.75), 25.0, 0.0), 0.34);
+  BackendConfig c = lineOfSightOnly();
   c.line_of_sight_pairs = line_of_sight_pairs;
   SlidingWindow window(c);
   std::mt19937 rng(5);
   double sq = 0;
   int n = 0;
   for (BackendInput in : scene.generate(7)) {
-    for (ObservationInput& o : in.observations)
-      o.points = std::make_shared<const ObjectPoints>(
-          scanBox(scene.objectTruth(1, in.frame), kCar, Eigen::Vector3d::Zero(), rng));
+    scanTheCar(scene, in, rng);
     const BackendOutput out = window.process(in);
     for (const TrackEstimate& e : out.tracks) {
       if (in.frame < 4) continue;  // two scan pairs at least
@@ -141,42 +158,26 @@ namespace {
 
 // An oncoming car 100 m ahead at 15 m/s that brakes at 3 m/s^2 from 1 s on, seen head-on by an ego
 // driving at 5 m/s, its boxes as far off as the backend's noise model says at 70 m (0.105 m x
-// (1 + 0.035 x 70 m) = 0.36 m), its registrations held off (a point count no car reaches): the RMS
-// and mean error of its published velocity from frame 12 (its chain spans the window) to 30
+// (1 + 0.035 x 70 m) = 0.36 m): the RMS and mean error of its published velocity from frame 12 (its chain spans the window) to 30
 // (braking; 40 m away at the end), with and without the line of sight on its chain.
 struct BrakingErrors {
   double rmse = 0, mean = 0;
 };
 BrakingErrors brakingOncomingCar(bool on_chain) {
-  SimScene scene;
-  scene.ego = constantTwist(Pose::Identity(), 5.0, 0.0);
   const auto along = [](double t) {  // distance driven and speed
     const double tb = std::clamp(t - 1.0, 0.0, 5.0);
     return std::make_pair(15.0 * std::min(t, 1.0) + 15.0 * tb - 1.5 * tb * tb, t < 1.0 ? 15.0 : 15.0 - 3.0 * tb);
   };
-  SimObject car;
-  car.id = 1;
-  car.type = "Car";
-  car.size = kCar;
-  car.pose = [along](double t) { return planarPose(100.0 - along(t).first, 3.5, M_PI); };
-  car.dynamic_guess = true;
-  scene.objects = {car};
-  scene.box_noise = Eigen::Vector3d(0.36, 0.36, 0.05);
-  BackendConfig c;
-  c.compute_covariance = false;
-  c.observation_sigma_growth_per_m = 0.035;
-  c.registration_types = {"Car"};
-  c.registration.min_points = 100000;
+  SimScene scene = oneCar([along](double t) { return planarPose(100.0 - along(t).first, 3.5, M_PI); }, 0.36);
+  scene.ego = constantTwist(Pose::Identity(), 5.0, 0.0);
+  BackendConfig c = lineOfSightOnly();
   c.line_of_sight_chain = on_chain;
   SlidingWindow window(c);
   std::mt19937 rng(6);
   double sq = 0, sum = 0;
   int n = 0;
   for (BackendInput in : scene.generate(31)) {
-    const Pose X = scene.egoTruth(in.frame);
-    for (ObservationInput& o : in.observations)
-      o.points = std::make_shared<const ObjectPoints>(
-          scanBox(X.inverse() * scene.objectTruth(1, in.frame), kCar, Eigen::Vector3d::Zero(), rng));
+    scanTheCar(scene, in, rng);
     const BackendOutput out = window.process(in);
     if (in.frame < 12) continue;
     for (const TrackEstimate& e : out.tracks) {

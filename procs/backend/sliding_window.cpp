@@ -271,8 +271,10 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
     p += t * (ego.angular.cross(p) + ego.velocity - v_obj);
     world.push_back((X * p).cast<float>());
   }
-  // The young path reads it (youngVehicleVelocity), the chain takes each pair as a factor.
-  out.line_of_sight_pairs += measureLineOfSight(track, world, obs.box, frame, X, frame_dt);
+  // The young path reads it (youngVehicleVelocity); a chain takes each pair as a factor when
+  // line_of_sight_chain is set, and needs none otherwise.
+  if (!track.velocity_from_chain || config_.line_of_sight_chain)
+    out.line_of_sight_pairs += measureLineOfSight(track, world, obs.box, frame, X, frame_dt);
   const std::shared_ptr<const PreparedObject> previous = track.points;
   const int previous_frame = track.points_frame;
   const double range = obs.box.center.norm();

@@ -21,6 +21,7 @@
 #include "backend/odometry_factor.hpp"
 #include "backend/pose_change_factor.hpp"
 #include "backend/registration_factor.hpp"
+#include "backend/face_heading_factor.hpp"
 #include "backend/sight_speed_factor.hpp"
 #include "backend/vehicle_motion_factor.hpp"
 #include "backend/pose_manifold.hpp"
@@ -277,6 +278,25 @@ TEST(BackendFactors, SightSpeedMeasuresTheFaceAgainstTheSensor) {
               0.1, 1e-9);
   EXPECT_NEAR(residual(f, {toBlock(X1), toBlock(X2), toBlock(o1), toBlock(o1.inverse() * planarPose(40.5, 0.3, 0.05))})[0],
               0.0, 1e-9);
+}
+
+TEST(BackendFactors, FaceHeadingResidualAndJacobians) {
+  std::mt19937 rng(15);
+  std::uniform_real_distribution<double> offset(-0.2, 0.2);
+  for (int i = 0; i < 10; ++i) {
+    const Pose X = randomPose(rng), o = randomPose(rng);
+    const Eigen::Vector3d h = X.linear().transpose() * o.linear().col(0);
+    const double e = offset(rng);
+    FaceHeadingFactor f(std::atan2(h.y(), h.x()) - e, 0.01);
+    const std::vector<Vector7> blocks{toBlock(X), toBlock(o)};
+    const Vector6 r = residual(f, blocks);
+    EXPECT_NEAR(r[0], e / 0.01, 1e-9);
+    EXPECT_LT(r.tail<5>().norm(), 1e-12);
+    expectJacobiansMatchNumeric(f, blocks);
+  }
+  // Front and back are one heading to a face fit: a car turned round is no error.
+  FaceHeadingFactor f(0.3, 0.01);
+  EXPECT_NEAR(residual(f, {toBlock(planarPose(5, 1, 0.2)), toBlock(planarPose(20, 3, 0.5 + M_PI))})[0], 0.0, 1e-9);
 }
 
 TEST(BackendFactors, ConstantVelocityResidualAndJacobians) {

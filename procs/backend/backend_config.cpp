@@ -162,6 +162,7 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   s.get("line_of_sight_sigma", c.line_of_sight_sigma);
   require(c.line_of_sight_sigma > 0.0, s, "line_of_sight_sigma", "a speed > 0 (m/s)");
   s.get("line_of_sight_chain", c.line_of_sight_chain);
+  s.get("face_heading", c.face_heading);
   s.get("registration_ground_clearance", c.registration_ground_clearance);
   require(c.registration_ground_clearance >= 0.0, s, "registration_ground_clearance", "a distance >= 0 (m)");
   s.get("solver_threads", c.solver_threads);

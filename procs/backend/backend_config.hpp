@@ -99,6 +99,9 @@ struct BackendConfig {
   // Each pair also a factor on a vehicle's chain once it spans the window, for the frames no
   // registration measured (sight_speed_factor.hpp).
   bool line_of_sight_chain = true;
+  // A registering vehicle's heading from the faces its points show, each scan a factor on its
+  // pose (face_heading.hpp).
+  bool face_heading = true;
   // The scans' firing order, from the config's lidar section (LidarConfig): a registered object's
   // points are moved to the scan's reference instant (its pose's, its boxes') by the ego's motion
   // and the object's over the time from their firing. period 0: de-skewed scans.

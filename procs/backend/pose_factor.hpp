@@ -46,6 +46,12 @@ class PoseFactor : public ceres::CostFunction {
   }
 
  protected:
+  // The whitening of a factor with a single residual, e[0] with standard deviation sigma.
+  static Matrix6 scalarWhitening(double sigma) {
+    Matrix6 S = Matrix6::Zero();
+    S(0, 0) = 1.0 / sigma;
+    return S;
+  }
   // The unwhitened error and its tangent Jacobians d[k] (where not null).
   virtual Vector6 error(double const* const* x, Matrix6* const* d) const = 0;
 

@@ -21,7 +21,7 @@ class SightSpeedFactor final : public PoseFactor {
   // u: the horizontal unit line of sight (world); d_meas: the face's displacement against the
   // sensor along u (m); sigma: its standard deviation (m).
   SightSpeedFactor(const Eigen::Vector3d& u, double d_meas, double sigma)
-      : PoseFactor(4, whitening(sigma)), u_(u), d_meas_(d_meas) {}
+      : PoseFactor(4, scalarWhitening(sigma)), u_(u), d_meas_(d_meas) {}
   static ceres::CostFunction* Create(const Eigen::Vector3d& u, double d_meas, double sigma) {
     return new SightSpeedFactor(u, d_meas, sigma);
   }
@@ -48,11 +48,6 @@ class SightSpeedFactor final : public PoseFactor {
   }
 
  private:
-  static Matrix6 whitening(double sigma) {
-    Matrix6 S = Matrix6::Zero();
-    S(0, 0) = 1.0 / sigma;
-    return S;
-  }
   Eigen::Vector3d u_;
   double d_meas_;
 };

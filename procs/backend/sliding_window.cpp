@@ -7,6 +7,7 @@
 
 #include "backend/constant_acceleration_factor.hpp"
 #include "backend/constant_velocity_factor.hpp"
+#include "backend/face_heading_factor.hpp"
 #include "backend/landmark_observation_factor.hpp"
 #include "backend/marginalization_prior.hpp"
 #include "backend/motion_evidence.hpp"
@@ -271,6 +272,17 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
     p += t * (ego.angular.cross(p) + ego.velocity - v_obj);
     world.push_back((X * p).cast<float>());
   }
+  if (config_.face_heading) {
+    Box box = obs.box;
+    box.center = X * obs.box.center;
+    box.yaw = obs.box.yaw + yawOf(X.linear());
+    if (std::optional<FaceHeading> face = faceHeading(world, box, X.translation())) {
+      // Kept in the scan's axes, as the factor measures it (face_heading_factor.hpp).
+      const Eigen::Vector3d h = X.linear().transpose() * Eigen::Vector3d(std::cos(face->yaw), std::sin(face->yaw), 0.0);
+      face->yaw = std::atan2(h.y(), h.x());
+      track.face_headings[frame] = *face;
+    }
+  }
   // The young path reads it (youngVehicleVelocity); a chain takes each pair as a factor when
   // line_of_sight_chain is set, and needs none otherwise.
   if (!track.velocity_from_chain || config_.line_of_sight_chain)
@@ -347,7 +359,7 @@ bool SlidingWindow::measureLineOfSight(Track& track, const ObjectPoints& world, 
   return paired;
 }
 
-std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track, const std::optional<BoxHeading>& heading) const {
+std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track, const std::optional<WindowHeading>& heading) const {
   std::vector<TimedPosition> positions(track.past_boxes.begin(), track.past_boxes.end());
   double range_sum = 0;
   int in_window = 0;
@@ -369,32 +381,45 @@ std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track, const st
   return fitSpeedAmongOutliers(positions, sigma, 5.0, heading ? &heading->direction : nullptr);
 }
 
-std::optional<SlidingWindow::BoxHeading> SlidingWindow::boxHeading(const Track& track) const {
+std::optional<SlidingWindow::WindowHeading> SlidingWindow::windowHeading(const Track& track) const {
   if (!isVehicle(track.type)) return std::nullopt;
-  // The mean heading of its boxes in the window (each box's own yaw noise is its class's rz).
+  // Unit headings weighted by their inverse variances: a box's is its class's rz sigma, a face
+  // fit's its own (a tenth of it, or less). A face does not know front from back: it is taken
+  // along its box.
+  const double box_weight = std::pow(config_.boxSigma(track.type, true)[5], -2);
   Eigen::Vector2d heading = Eigen::Vector2d::Zero();
-  int n = 0;
+  double weight = 0;
   for (const auto& [f, obs] : track.observations)
     if (const EgoFrame* ego = findFrame(f)) {
-      const double yaw = yawOf(fromBlock(ego->pose->data()).linear() * obs.b.linear());
-      heading += Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
-      ++n;
+      const Eigen::Matrix3d R = fromBlock(ego->pose->data()).linear();
+      const double yaw = yawOf(R * obs.b.linear());
+      Eigen::Vector2d h(std::cos(yaw), std::sin(yaw));
+      double w = box_weight;
+      if (const auto face = track.face_headings.find(f); face != track.face_headings.end()) {
+        const Eigen::Vector2d along = (R * Eigen::Vector3d(std::cos(face->second.yaw), std::sin(face->second.yaw), 0)).head<2>();
+        const Eigen::Vector2d face_h = along.normalized() * (along.dot(h) < 0 ? -1.0 : 1.0);
+        const double face_w = std::pow(face->second.sigma, -2);
+        h = (w * h + face_w * face_h).normalized();
+        w += face_w;
+      }
+      heading += w * h;
+      weight += w;
     }
-  if (n == 0 || heading.norm() < 1e-9) return std::nullopt;
-  return BoxHeading{heading.normalized(), config_.boxSigma(track.type, true)[5] / std::sqrt(double(n))};
+  if (weight <= 0 || heading.norm() < 1e-9) return std::nullopt;
+  return WindowHeading{heading.normalized(), 1.0 / std::sqrt(weight)};
 }
 
 std::optional<SlidingWindow::LineVelocity> SlidingWindow::boxLineVelocity(const Track& track) const {
-  const std::optional<BoxHeading> box_heading = boxHeading(track);
-  const std::optional<SpeedFit> fit = windowMotion(track, box_heading);
+  const std::optional<WindowHeading> window_heading = windowHeading(track);
+  const std::optional<SpeedFit> fit = windowMotion(track, window_heading);
   if (!fit) return std::nullopt;
   LineVelocity line;
   line.velocity = fit->velocity;
   const double var_fit = std::max(fit->sigma * fit->sigma, 1e-6);
   line.covariance = var_fit * Eigen::Matrix2d::Identity();
-  if (!box_heading) return line;
-  const Eigen::Vector2d& heading = box_heading->direction;
-  const double heading_sigma = box_heading->sigma;
+  if (!window_heading) return line;
+  const Eigen::Vector2d& heading = window_heading->direction;
+  const double heading_sigma = window_heading->sigma;
   line.velocity = velocityAlongHeading(*fit, heading, heading_sigma);
   // Across the heading the fused variance of the two (velocityAlongHeading's weights).
   const double var_heading = std::pow(fit->velocity.head<2>().norm() * heading_sigma, 2);
@@ -438,7 +463,7 @@ void SlidingWindow::startTrack(Track& track, int frame) {
   const auto moving = [&](double speed, double sigma) {
     return movesBeyond(speed, sigma, config_.static_max_speed, config_.dynamic_min_sigmas);
   };
-  const std::optional<SpeedFit> fit = windowMotion(track, boxHeading(track));
+  const std::optional<SpeedFit> fit = windowMotion(track, windowHeading(track));
   bool dynamic = fit ? moving(fit->speed, fit->sigma) : track.dynamic_guess;
   // A vehicle whose points measured its motion (registrations, the line of sight): that motion
   // fused with its boxes' line bounds its speed far more tightly than 3-4 boxes do. Queues' vans
@@ -471,6 +496,9 @@ void SlidingWindow::addTrackObservation(Track& track, int frame) {
   } else {
     extendChain(track, frame, X * obs.b);
     addFactor(ObservationFactor::Create(obs.b, S), true, {x, track.poses.at(frame)->data()});
+    // Its heading from its faces' points (robust: a neighbour's side in its box can turn the fit).
+    if (const auto face = track.face_headings.find(frame); face != track.face_headings.end())
+      addFactor(FaceHeadingFactor::Create(face->second.yaw, face->second.sigma), true, {x, track.poses.at(frame)->data()});
   }
   obs.in_graph = true;
 }
@@ -788,6 +816,7 @@ SmoothedPose SlidingWindow::slide() {
     track.observations.erase(track.observations.begin(), track.observations.upper_bound(s));
     track.motions.erase(track.motions.begin(), track.motions.upper_bound(s));
     track.sight_speeds.erase(track.sight_speeds.begin(), track.sight_speeds.upper_bound(s));
+    track.face_headings.erase(track.face_headings.begin(), track.face_headings.upper_bound(s));
   }
   for (Track* track : left_view) {
     track->model = TrackModel::kNotInGraph;

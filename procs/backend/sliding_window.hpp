@@ -19,6 +19,7 @@
 
 #include "backend/backend_config.hpp"
 #include "backend/backend_types.hpp"
+#include "backend/face_heading.hpp"
 #include "backend/factor.hpp"
 #include "backend/line_of_sight.hpp"
 #include "backend/marginalizer.hpp"
@@ -107,6 +108,8 @@ class SlidingWindow {
     };
     std::optional<SightFace> sight;
     std::map<int, SightSpeed> sight_speeds;
+    // A vehicle's heading from its faces' points, per scan (face_heading.hpp; yaw in the scan's axes).
+    std::map<int, FaceHeading> face_headings;
     Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
   };
 
@@ -136,16 +139,17 @@ class SlidingWindow {
   // measured (registered_velocity.hpp); without registrations, with its speed along the line of
   // sight over its last scan pairs (line_of_sight.hpp); else the line as it is.
   LineVelocity youngVehicleVelocity(const Track& track, const LineVelocity& line) const;
-  // A vehicle's mean bird's-eye heading over its boxes in the window and its standard deviation
-  // (rad); none for other classes.
-  struct BoxHeading {
+  // A vehicle's bird's-eye heading over the window and its standard deviation (rad): the mean of
+  // its boxes' and its faces' headings (face_heading.hpp), each weighted by its inverse variance;
+  // none for other classes.
+  struct WindowHeading {
     Eigen::Vector2d direction;
     double sigma = 0;
   };
-  std::optional<BoxHeading> boxHeading(const Track& track) const;
+  std::optional<WindowHeading> windowHeading(const Track& track) const;
   // The least-squares motion of the track's observed positions in the window (world frame),
   // boxes of another object left out (with a vehicle's heading, also those that moved across it).
-  std::optional<SpeedFit> windowMotion(const Track& track, const std::optional<BoxHeading>& heading) const;
+  std::optional<SpeedFit> windowMotion(const Track& track, const std::optional<WindowHeading>& heading) const;
   void addTrackObservation(Track& track, int frame);
   void extendChain(Track& track, int frame, const Pose& o);
   // The prior that starts a vehicle's chain straight on its first pose change c_{f-1}^f, which

@@ -150,7 +150,8 @@ HeadingErrors overtakingCar(bool face_heading) {
 // sideways 0.091 -> 0.075 m/s).
 TEST(FaceHeading, AnOvertakingCarsHeadingAndSidewaysVelocityFromItsFaces) {
   const HeadingErrors with = overtakingCar(true), without = overtakingCar(false);
-  std::printf("overtaking car: heading RMSE %.3f deg, sideways velocity %.3f m/s with its faces; %.3f deg, %.3f m/s without\n",
+  std::printf("overtaking car: heading RMSE %.3f deg, sideways velocity %.3f m/s with its faces; "
+              "%.3f deg, %.3f m/s without\n",
               with.heading_deg, with.across_mps, without.heading_deg, without.across_mps);
   EXPECT_LT(with.heading_deg, 0.5 * without.heading_deg);
   EXPECT_LT(with.across_mps, 0.9 * without.across_mps);

@@ -359,7 +359,8 @@ bool SlidingWindow::measureLineOfSight(Track& track, const ObjectPoints& world, 
   return paired;
 }
 
-std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track, const std::optional<WindowHeading>& heading) const {
+std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track,
+                                                    const std::optional<WindowHeading>& heading) const {
   std::vector<TimedPosition> positions(track.past_boxes.begin(), track.past_boxes.end());
   double range_sum = 0;
   int in_window = 0;
@@ -396,7 +397,8 @@ std::optional<SlidingWindow::WindowHeading> SlidingWindow::windowHeading(const T
       Eigen::Vector2d h(std::cos(yaw), std::sin(yaw));
       double w = box_weight;
       if (const auto face = track.face_headings.find(f); face != track.face_headings.end()) {
-        const Eigen::Vector2d along = (R * Eigen::Vector3d(std::cos(face->second.yaw), std::sin(face->second.yaw), 0)).head<2>();
+        const double a = face->second.yaw;  // in the scan's axes
+        const Eigen::Vector2d along = (R * Eigen::Vector3d(std::cos(a), std::sin(a), 0)).head<2>();
         const Eigen::Vector2d face_h = along.normalized() * (along.dot(h) < 0 ? -1.0 : 1.0);
         const double face_w = std::pow(face->second.sigma, -2);
         h = (w * h + face_w * face_h).normalized();
@@ -498,7 +500,8 @@ void SlidingWindow::addTrackObservation(Track& track, int frame) {
     addFactor(ObservationFactor::Create(obs.b, S), true, {x, track.poses.at(frame)->data()});
     // Its heading from its faces' points (robust: a neighbour's side in its box can turn the fit).
     if (const auto face = track.face_headings.find(frame); face != track.face_headings.end())
-      addFactor(FaceHeadingFactor::Create(face->second.yaw, face->second.sigma), true, {x, track.poses.at(frame)->data()});
+      addFactor(FaceHeadingFactor::Create(face->second.yaw, face->second.sigma), true,
+                {x, track.poses.at(frame)->data()});
   }
   obs.in_graph = true;
 }

@@ -9,17 +9,17 @@
 
 #include "backend/face_heading.hpp"
 #include "backend/sliding_window.hpp"
-#include "backend_scene.hpp"
-#include "object_scan.hpp"
+#include "one_car_scene.hpp"
 
 using namespace dlslot;
 using namespace dlslot::backend;
 using dlslot::backend::test::constantTwist;
 using dlslot::backend::test::kCar;
 using dlslot::backend::test::kSensor;
+using dlslot::backend::test::oneCar;
 using dlslot::backend::test::planarPose;
 using dlslot::backend::test::scanBox;
-using dlslot::backend::test::SimObject;
+using dlslot::backend::test::scanTheCar;
 using dlslot::backend::test::SimScene;
 
 namespace {
@@ -102,18 +102,13 @@ struct HeadingErrors {
 HeadingErrors overtakingCar(bool face_heading) {
   const double w = 2 * M_PI / 8.0;
   const auto velocity = [w](double t) { return Eigen::Vector2d(25.0, 1.75 * w * std::cos(w * t)); };
-  SimScene scene;
+  SimScene scene = oneCar(
+      [=](double t) {
+        const Eigen::Vector2d v = velocity(t);
+        return planarPose(8.0 + 25.0 * t, 3.5 + 1.75 * std::sin(w * t), std::atan2(v.y(), v.x()), -1.73 + 0.75);
+      },
+      0.15);
   scene.ego = constantTwist(Pose::Identity(), 22.0, 0.0);
-  SimObject car;
-  car.id = 1;
-  car.size = kCar;
-  car.pose = [=](double t) {
-    const Eigen::Vector2d v = velocity(t);
-    return planarPose(8.0 + 25.0 * t, 3.5 + 1.75 * std::sin(w * t), std::atan2(v.y(), v.x()), -1.73 + 0.75);
-  };
-  car.dynamic_guess = true;
-  scene.objects = {car};
-  scene.box_noise = Eigen::Vector3d(0.15, 0.15, 0.05);
   scene.yaw_noise = 0.04;
   BackendConfig c;
   c.compute_covariance = false;
@@ -126,9 +121,7 @@ HeadingErrors overtakingCar(bool face_heading) {
   int n = 0;
   for (BackendInput in : scene.generate(41)) {
     const Pose truth = scene.objectTruth(1, in.frame);
-    const Pose car_in_lidar = scene.egoTruth(in.frame).inverse() * truth;
-    for (ObservationInput& o : in.observations)
-      o.points = std::make_shared<const ObjectPoints>(scanBox(car_in_lidar, kCar, Eigen::Vector3d::Zero(), rng));
+    scanTheCar(scene, in, rng);
     const BackendOutput out = window.process(in);
     if (in.frame < 10) continue;
     const Eigen::Vector2d v = velocity(scene.time(in.frame)), across = Eigen::Vector2d(-v.y(), v.x()).normalized();

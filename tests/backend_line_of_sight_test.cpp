@@ -10,8 +10,7 @@
 
 #include "backend/line_of_sight.hpp"
 #include "backend/sliding_window.hpp"
-#include "backend_scene.hpp"
-#include "object_scan.hpp"
+#include "one_car_scene.hpp"
 
 using namespace dlslot;
 using namespace dlslot::backend;
@@ -19,9 +18,10 @@ using dlslot::backend::test::kCar;
 using dlslot::backend::test::kSensor;
 using dlslot::backend::test::planarPose;
 using dlslot::backend::test::scanBox;
-using dlslot::backend::test::SimObject;
 using dlslot::backend::test::SimScene;
 using dlslot::backend::test::constantTwist;
+using dlslot::backend::test::oneCar;
+using dlslot::backend::test::scanTheCar;
 
 TEST(LineOfSight, TheFacesRangeIgnoresAStrayPointAndTheBodyBehindIt) {
   ObjectPoints points;
@@ -90,20 +90,6 @@ TEST(LineOfSight, TheMedianPairAlongTheNewestLineOfSightOnly) {
 
 namespace {
 
-// One car (id 1) whose boxes are box_noise off, seen by an ego at the origin unless told otherwise.
-SimScene oneCar(std::function<Pose(double)> pose, double box_noise) {
-  SimScene scene;
-  SimObject car;
-  car.id = 1;
-  car.type = "Car";
-  car.size = kCar;
-  car.pose = std::move(pose);
-  car.dynamic_guess = true;
-  scene.objects = {car};
-  scene.box_noise = Eigen::Vector3d(box_noise, box_noise, 0.05);
-  return scene;
-}
-
 // A backend whose only measurement of the car's points is the line of sight: its registrations
 // are held off by a point count no car reaches.
 BackendConfig lineOfSightOnly() {
@@ -113,13 +99,6 @@ BackendConfig lineOfSightOnly() {
   c.registration_types = {"Car"};
   c.registration.min_points = 100000;
   return c;
-}
-
-// The car's points in this frame's scan (lidar frame).
-void scanTheCar(const SimScene& scene, BackendInput& in, std::mt19937& rng) {
-  const Pose car_in_lidar = scene.egoTruth(in.frame).inverse() * scene.objectTruth(1, in.frame);
-  for (ObservationInput& o : in.observations)
-    o.points = std::make_shared<const ObjectPoints>(scanBox(car_in_lidar, kCar, Eigen::Vector3d::Zero(), rng));
 }
 
 // A young oncoming car 70 -> 55 m ahead at 25 m/s, its boxes as far off as the backend's noise

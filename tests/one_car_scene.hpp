@@ -1,0 +1,37 @@
+// One car in a synthetic scene (backend_scene.hpp) whose points are scanned each frame
+// (object_scan.hpp): for the backend tests of what a vehicle's own points measure.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <random>
+#include <utility>
+
+#include "backend_scene.hpp"
+#include "object_scan.hpp"
+
+namespace dlslot::backend::test {
+
+// One car (id 1, kCar) on `pose`, its boxes box_noise off (x, y; 0.05 m in z), seen by an ego at
+// the origin unless the scene is told otherwise.
+inline SimScene oneCar(std::function<Pose(double)> pose, double box_noise) {
+  SimScene scene;
+  SimObject car;
+  car.id = 1;
+  car.type = "Car";
+  car.size = kCar;
+  car.pose = std::move(pose);
+  car.dynamic_guess = true;
+  scene.objects = {car};
+  scene.box_noise = Eigen::Vector3d(box_noise, box_noise, 0.05);
+  return scene;
+}
+
+// The car's points in this frame's scan (lidar frame), given to its observation.
+inline void scanTheCar(const SimScene& scene, BackendInput& in, std::mt19937& rng) {
+  const Pose car_in_lidar = scene.egoTruth(in.frame).inverse() * scene.objectTruth(1, in.frame);
+  for (ObservationInput& o : in.observations)
+    o.points = std::make_shared<const ObjectPoints>(scanBox(car_in_lidar, kCar, Eigen::Vector3d::Zero(), rng));
+}
+
+}  // namespace dlslot::backend::test

@@ -87,6 +87,13 @@ TEST(FaceHeading, NothingWithoutFacesToFit) {
   EXPECT_FALSE(faceHeading(points, detectorBox(near, 0, 0, 0), near.translation()));
   EXPECT_FALSE(faceHeading(points, detectorBox(near, 0, 0, 20 * kDeg), kSensor));
   EXPECT_FALSE(faceHeading({}, detectorBox(near, 0, 0, 0), kSensor));
+  // Points that are not numbers (a corrupt scan) are no points.
+  ObjectPoints corrupt = points;
+  for (int i = 0; i < 50; ++i) corrupt.emplace_back(NAN, NAN, NAN);
+  const std::optional<FaceHeading> face = faceHeading(corrupt, detectorBox(near, 0, 0, 0), kSensor);
+  ASSERT_TRUE(face);
+  EXPECT_TRUE(std::isfinite(face->yaw) && std::isfinite(face->sigma));
+  EXPECT_FALSE(faceHeading(ObjectPoints(100, Eigen::Vector3f(NAN, NAN, NAN)), detectorBox(near, 0, 0, 0), kSensor));
 }
 
 namespace {

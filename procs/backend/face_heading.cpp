@@ -119,7 +119,7 @@ std::optional<FaceHeading> faceHeading(const ObjectPoints& points, const Box& bo
   if (!(h00 > 0)) return std::nullopt;
   const double variance = sigma2 / (o.information_scale * h00) + o.accuracy_rad * o.accuracy_rad;
   const double sigma = std::sqrt(variance);
-  if (sigma > o.max_sigma_rad) return std::nullopt;
+  if (!(sigma <= o.max_sigma_rad)) return std::nullopt;  // NaN too
   FaceHeading f;
   f.yaw = box.yaw + wrapAngle(theta - box.yaw);
   f.sigma = sigma;

@@ -14,14 +14,7 @@
 
 using namespace dlslot;
 using namespace dlslot::backend;
-using dlslot::backend::test::kCar;
-using dlslot::backend::test::kSensor;
-using dlslot::backend::test::planarPose;
-using dlslot::backend::test::scanBox;
-using dlslot::backend::test::SimScene;
-using dlslot::backend::test::constantTwist;
-using dlslot::backend::test::oneCar;
-using dlslot::backend::test::scanTheCar;
+using namespace dlslot::backend::test;
 
 TEST(LineOfSight, TheFacesRangeIgnoresAStrayPointAndTheBodyBehindIt) {
   ObjectPoints points;

@@ -81,6 +81,23 @@ TEST(LineOfSight, TheMedianPairAlongTheNewestLineOfSightOnly) {
   EXPECT_FALSE(lineOfSightVelocity({}, 0.3));
 }
 
+TEST(LineOfSight, AFewPointPairCountsOnlyWhereAnotherAgrees) {
+  const Eigen::Vector2d u(1, 0);
+  const auto pair = [&](double speed, int points) { return SightSpeed{u, speed, 0.0, points}; };
+  // A car's first pairs, the second from 11 points on the bonnet: neither counts alone; before,
+  // their mean was 5 m/s.
+  EXPECT_FALSE(lineOfSightVelocity({pair(-1.13, 15), pair(11.2, 11)}, 0.3, 20));
+  // Two that agree within 2 sigma count, the stray one does not (the median of the two).
+  EXPECT_TRUE(lineOfSightVelocity({pair(-1.1, 15), pair(11.2, 11), pair(-1.5, 12)}, 0.3, 20)
+                  ->velocity.isApprox(-1.3 * u, 1e-12));
+  // A pair of 20 points or more counts alone, and lets a few-point pair that agrees with it count.
+  EXPECT_TRUE(lineOfSightVelocity({pair(-1.2, 25)}, 0.3, 20)->velocity.isApprox(-1.2 * u, 1e-12));
+  EXPECT_TRUE(lineOfSightVelocity({pair(-1.2, 25), pair(-1.0, 12), pair(5.0, 12)}, 0.3, 20)
+                  ->velocity.isApprox(-1.1 * u, 1e-12));
+  // Without a point threshold every pair counts, as before.
+  EXPECT_TRUE(lineOfSightVelocity({pair(-1.13, 15), pair(11.2, 11)}, 0.3)->velocity.isApprox(5.035 * u, 1e-12));
+}
+
 namespace {
 
 // A backend whose only measurement of the car's points is the line of sight: its registrations

@@ -154,6 +154,9 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   require(c.registration_box_margin_sigmas >= 0.0, s, "registration_box_margin_sigmas", "a number >= 0 (standard deviations)");
   s.get("line_of_sight_min_points", c.line_of_sight_min_points);
   require(c.line_of_sight_min_points >= 1, s, "line_of_sight_min_points", "an integer >= 1");
+  s.get("line_of_sight_young_min_points", c.line_of_sight_young_min_points);
+  require(c.line_of_sight_young_min_points >= 1 && c.line_of_sight_young_min_points <= c.line_of_sight_min_points, s,
+          "line_of_sight_young_min_points", "an integer in [1, line_of_sight_min_points]");
   s.get("line_of_sight_max_angle_deg", c.line_of_sight_max_angle_deg);
   require(c.line_of_sight_max_angle_deg >= 0.0 && c.line_of_sight_max_angle_deg <= 90.0, s, "line_of_sight_max_angle_deg",
           "an angle in [0, 90] (deg)");

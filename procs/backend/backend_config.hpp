@@ -93,6 +93,9 @@ struct BackendConfig {
   // line_of_sight_pairs frames, worth line_of_sight_sigma (m/s; the measured spread of the good
   // pairs, 0.24-0.39). line_of_sight_pairs 0: not used.
   int line_of_sight_min_points = 20;
+  // The young path also takes pairs of this many points or more, each only where another pair
+  // agrees with it (lineOfSightVelocity); the chain only those of line_of_sight_min_points.
+  int line_of_sight_young_min_points = 10;
   double line_of_sight_max_angle_deg = 10.0;  // the box's heading from the line of sight (facesTheSensor)
   int line_of_sight_pairs = 3;
   double line_of_sight_sigma = 0.3;

@@ -34,11 +34,23 @@ std::optional<Eigen::Vector3d> lineOfSight(const ObjectPoints& points, const Eig
   return u.normalized();
 }
 
-std::optional<VelocityEvidence> lineOfSightVelocity(const std::vector<SightSpeed>& pairs, double sigma_mps) {
-  if (pairs.empty() || !(sigma_mps > 0)) return std::nullopt;
+std::optional<VelocityEvidence> lineOfSightVelocity(const std::vector<SightSpeed>& pairs, double sigma_mps,
+                                                    int trusted_points) {
+  if (!(sigma_mps > 0)) return std::nullopt;
+  // Two good pairs differ by sqrt(2) sigma_mps (standard deviation); within two of those they agree.
+  const double agree = 2.0 * std::sqrt(2.0) * sigma_mps;
   std::vector<double> speeds;
-  for (const SightSpeed& p : pairs) speeds.push_back(p.speed);
-  const Eigen::Vector2d u = pairs.back().u;
+  const SightSpeed* newest = nullptr;
+  for (const SightSpeed& p : pairs) {
+    bool counts = p.points >= trusted_points;
+    for (const SightSpeed& q : pairs)
+      counts = counts || (&q != &p && std::abs(q.speed - p.speed) <= agree);
+    if (!counts) continue;
+    speeds.push_back(p.speed);
+    newest = &p;
+  }
+  if (!newest) return std::nullopt;
+  const Eigen::Vector2d u = newest->u;
   VelocityEvidence v;
   v.velocity = median(speeds) * u;
   v.information = u * u.transpose() / (sigma_mps * sigma_mps);

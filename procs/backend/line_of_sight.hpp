@@ -48,10 +48,16 @@ struct SightSpeed {
   // The sensor's displacement along u between the two scans (m) in the ego poses the pair was
   // measured with: speed x dt minus it is the face's motion against the sensor (sight_speed_factor.hpp).
   double sensor_displacement = 0;
+  int points = 0;  // the fewer of the two scans' points
 };
 
 // The median of the pairs' speeds as a velocity measured along the newest pair's u alone, with
-// standard deviation sigma_mps there and no information across it. Nothing without pairs.
-std::optional<VelocityEvidence> lineOfSightVelocity(const std::vector<SightSpeed>& pairs, double sigma_mps);
+// standard deviation sigma_mps there and no information across it. A pair of fewer than
+// trusted_points points counts only when another pair agrees with it within 2 sigma_mps: below 20
+// points a third or more of the pairs are over 1 m/s off, and two such pairs rarely agree (the
+// median of two pairs is their mean, so one of them took a car's first velocity 6 m/s off).
+// Nothing without pairs that count.
+std::optional<VelocityEvidence> lineOfSightVelocity(const std::vector<SightSpeed>& pairs, double sigma_mps,
+                                                    int trusted_points = 0);
 
 }  // namespace dlslot::backend

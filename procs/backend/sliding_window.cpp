@@ -340,7 +340,7 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
 bool SlidingWindow::measureLineOfSight(Track& track, const ObjectPoints& world, const Box& box, int frame, const Pose& X,
                                       double dt) const {
   if (config_.line_of_sight_pairs <= 0) return false;
-  if (static_cast<int>(world.size()) < config_.line_of_sight_min_points ||
+  if (static_cast<int>(world.size()) < config_.line_of_sight_young_min_points ||
       !facesTheSensor(box, config_.line_of_sight_max_angle_deg)) {
     track.sight.reset();  // no pair across this scan
     return false;
@@ -350,12 +350,13 @@ bool SlidingWindow::measureLineOfSight(Track& track, const ObjectPoints& world, 
   if (track.sight && track.sight->frame == frame - 1 && dt > 0)
     if (const std::optional<double> range = nearFaceRange(world, track.sight->u)) {
       track.sight_speeds[frame] = SightSpeed{track.sight->u.head<2>(), (*range - track.sight->range) / dt,
-                                             track.sight->u.dot(X.translation() - track.sight->sensor)};
+                                             track.sight->u.dot(X.translation() - track.sight->sensor),
+                                             std::min(track.sight->points, static_cast<int>(world.size()))};
       paired = true;
     }
   track.sight.reset();
   if (const std::optional<Eigen::Vector3d> u = lineOfSight(world, X.translation()))
-    track.sight = Track::SightFace{frame, *u, *nearFaceRange(world, *u), X.translation()};
+    track.sight = Track::SightFace{frame, *u, *nearFaceRange(world, *u), static_cast<int>(world.size()), X.translation()};
   return paired;
 }
 
@@ -449,7 +450,7 @@ SlidingWindow::LineVelocity SlidingWindow::youngVehicleVelocity(const Track& tra
     std::vector<SightSpeed> pairs;
     const auto first = track.sight_speeds.lower_bound(t - config_.line_of_sight_pairs + 1);
     for (auto it = first; it != track.sight_speeds.end(); ++it) pairs.push_back(it->second);
-    if (const auto sight = lineOfSightVelocity(pairs, config_.line_of_sight_sigma)) registered.push_back(*sight);
+    if (const auto sight = lineOfSightVelocity(pairs, config_.line_of_sight_sigma, config_.line_of_sight_min_points)) registered.push_back(*sight);
   }
   if (registered.empty()) return line;
   const FusedVelocity fused = fuseVelocities(line.velocity.head<2>(), line.covariance, registered);
@@ -534,7 +535,8 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
       addFactor(RegistrationFactor::Create(rm.A_meas, rm.sqrt_info), true,
                 {ego_prev->pose->data(), ego_cur->pose->data(), prev, change});
     } else if (const auto sight = track.sight_speeds.find(f);
-               config_.line_of_sight_chain && track.velocity_from_chain && sight != track.sight_speeds.end() && ego_prev && ego_cur) {
+               config_.line_of_sight_chain && track.velocity_from_chain && sight != track.sight_speeds.end() &&
+               sight->second.points >= config_.line_of_sight_min_points && ego_prev && ego_cur) {
       // No registration: the face's speed along the line of sight (robust: 13-31 % of the pairs
       // are over 1 m/s off, line_of_sight.hpp). Only on a chain that spans the window: a young
       // chain has too little else to outvote a face that jumps between scans (intersection seed 7:

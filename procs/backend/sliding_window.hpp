@@ -104,6 +104,7 @@ class SlidingWindow {
       int frame = -1;
       Eigen::Vector3d u = Eigen::Vector3d::UnitX();
       double range = 0;
+      int points = 0;
       Eigen::Vector3d sensor = Eigen::Vector3d::Zero();  // the ego position its points were put in the world with
     };
     std::optional<SightFace> sight;

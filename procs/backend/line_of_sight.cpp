@@ -37,7 +37,6 @@ std::optional<Eigen::Vector3d> lineOfSight(const ObjectPoints& points, const Eig
 std::optional<VelocityEvidence> lineOfSightVelocity(const std::vector<SightSpeed>& pairs, double sigma_mps,
                                                     int trusted_points) {
   if (!(sigma_mps > 0)) return std::nullopt;
-  // Two good pairs differ by sqrt(2) sigma_mps (standard deviation); within two of those they agree.
   const double agree = 2.0 * std::sqrt(2.0) * sigma_mps;
   std::vector<double> speeds;
   const SightSpeed* newest = nullptr;

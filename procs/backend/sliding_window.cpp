@@ -450,7 +450,8 @@ SlidingWindow::LineVelocity SlidingWindow::youngVehicleVelocity(const Track& tra
     std::vector<SightSpeed> pairs;
     const auto first = track.sight_speeds.lower_bound(t - config_.line_of_sight_pairs + 1);
     for (auto it = first; it != track.sight_speeds.end(); ++it) pairs.push_back(it->second);
-    if (const auto sight = lineOfSightVelocity(pairs, config_.line_of_sight_sigma, config_.line_of_sight_min_points)) registered.push_back(*sight);
+    if (const auto sight = lineOfSightVelocity(pairs, config_.line_of_sight_sigma, config_.line_of_sight_min_points))
+      registered.push_back(*sight);
   }
   if (registered.empty()) return line;
   const FusedVelocity fused = fuseVelocities(line.velocity.head<2>(), line.covariance, registered);

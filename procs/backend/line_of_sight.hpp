@@ -51,13 +51,12 @@ struct SightSpeed {
   int points = 0;  // the fewer of the two scans' points
 };
 
-// The median of the pairs' speeds as a velocity measured along the newest pair's u alone, with
-// standard deviation sigma_mps there and no information across it. A pair of fewer than
-// trusted_points points counts only when another pair agrees with it, within two standard
-// deviations of the difference of two good pairs (2 sqrt(2) sigma_mps): below 20 points 38 % of the
-// pairs are over 1 m/s off, and two such pairs rarely agree (the median of two pairs is their mean,
-// so one stray pair took a car's first velocity 6 m/s off).
-// Nothing without pairs that count.
+// The median of the counted pairs' speeds as a velocity measured along the newest counted pair's u
+// alone, with standard deviation sigma_mps there and no information across it. A pair of fewer
+// than trusted_points points counts only when another pair agrees with it, within two standard
+// deviations of the difference of two good pairs (2 sqrt(2) sigma_mps): below 20 points 38 % of
+// the pairs are over 1 m/s off, and two such pairs rarely agree (the median of two pairs is their
+// mean, so one stray pair took a car's first velocity 6 m/s off). Nothing without pairs that count.
 std::optional<VelocityEvidence> lineOfSightVelocity(const std::vector<SightSpeed>& pairs, double sigma_mps,
                                                     int trusted_points = 0);
 

@@ -41,10 +41,8 @@ std::optional<VelocityEvidence> lineOfSightVelocity(const std::vector<SightSpeed
   std::vector<double> speeds;
   const SightSpeed* newest = nullptr;
   for (const SightSpeed& p : pairs) {
-    bool counts = p.points >= trusted_points;
-    for (const SightSpeed& q : pairs)
-      counts = counts || (&q != &p && std::abs(q.speed - p.speed) <= agree);
-    if (!counts) continue;
+    const auto agrees = [&](const SightSpeed& q) { return &q != &p && std::abs(q.speed - p.speed) <= agree; };
+    if (p.points < trusted_points && std::none_of(pairs.begin(), pairs.end(), agrees)) continue;
     speeds.push_back(p.speed);
     newest = &p;
   }

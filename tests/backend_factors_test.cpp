@@ -699,8 +699,8 @@ TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
   for (const char* bad : {"{Cyclist: 0}", "{Cyclist: fast}", "[0.3]"}) expectRefused("heading_sigma_by_type", bad);
   EXPECT_EQ(c.walker_line_span_s, 2.0);
   expectRefused("walker_line_span_s", "-1");
-  EXPECT_EQ(c.walker_switch_min_sigmas, 3.0);
-  expectRefused("walker_switch_min_sigmas", "-1");
+  EXPECT_EQ(c.switch_min_sigmas, 3.0);
+  expectRefused("switch_min_sigmas", "-1");
   EXPECT_EQ(c.vehicle_lateral_acceleration, 1.0);
   for (const char* bad : {"-1", "fast"}) expectRefused("vehicle_lateral_acceleration", bad);
 }

@@ -93,3 +93,13 @@ TEST(BackendMotionEvidence, VelocityAlongHeadingWeighsTheTwoEstimates) {
   // A heading at 90 deg to the motion is believed as much: the 10 m/s across it is halved.
   EXPECT_NEAR(velocityAlongHeading(fit, Eigen::Vector2d(0.0, 1.0), 0.05).x(), w * 10.0, 1e-9);
 }
+
+TEST(BackendMotionEvidence, OneAxisSigmasHaveThePlanesFalseAlarm) {
+  for (double k : {1.0, 2.0, 3.0}) {
+    const double k1 = sigmasOnOneAxis(k);
+    EXPECT_NEAR(std::erfc(k1 / std::sqrt(2.0)), std::exp(-0.5 * k * k), 1e-12);
+    EXPECT_LT(k1, k);
+  }
+  EXPECT_NEAR(sigmasOnOneAxis(2.0), 1.4934, 1e-4);  // 13.5 % of a still object's fits either way
+  EXPECT_NEAR(sigmasOnOneAxis(0.0), 0.0, 1e-12);
+}

@@ -86,5 +86,32 @@ TEST(RegisteredVelocity, FusionWeighsByInformationAndGatesOutliers) {
   EXPECT_NEAR(f.velocity.x(), (10.0 + 25.0 * 9.0) / 26.0, 1e-12);
 }
 
+// A still vehicle seen end-on: three registrations measure its speed along the line of sight (x)
+// to 0.2 m/s each and say nothing across it, where their velocities are noise.
+TEST(RegisteredVelocity, MotionCountsOnlyWhereMeasured) {
+  const auto endOn = [](double vx, double vy) {
+    VelocityEvidence e;
+    e.velocity = Eigen::Vector2d(vx, vy);
+    e.information(0, 0) = 1.0 / (0.2 * 0.2);
+    e.information(1, 1) = 1e-9;  // not measured: a velocity of 1e4 m/s costs nothing
+    return e;
+  };
+  // Creeping off at 1.3 m/s: 1.3 / (0.2 / sqrt 3) = 11 sigmas, and faster than 1 m/s.
+  EXPECT_TRUE(measuredMotion({endOn(1.2, 40.0), endOn(1.3, -70.0), endOn(1.4, 5.0)}, 1.0, 3.0));
+  // Still: the noise across the line of sight is no evidence of motion.
+  EXPECT_FALSE(measuredMotion({endOn(0.05, 40.0), endOn(-0.1, -70.0), endOn(0.02, 900.0)}, 1.0, 3.0));
+  // Slower than min_speed, or within min_sigmas of still (one registration: 1.1 m/s is 5.5 sigmas,
+  // 0.5 is 2.5).
+  EXPECT_FALSE(measuredMotion({endOn(0.9, 0.0), endOn(0.9, 0.0), endOn(0.9, 0.0)}, 1.0, 3.0));
+  EXPECT_TRUE(measuredMotion({endOn(1.1, 0.0)}, 1.0, 3.0));
+  EXPECT_FALSE(measuredMotion({endOn(1.1, 0.0)}, 1.0, 6.0));
+  // Measured in both directions: motion along y counts as well.
+  VelocityEvidence full;
+  full.velocity = Eigen::Vector2d(0.0, -1.5);
+  full.information = Eigen::Matrix2d::Identity() / (0.2 * 0.2);
+  EXPECT_TRUE(measuredMotion({full}, 1.0, 3.0));
+  EXPECT_FALSE(measuredMotion({}, 1.0, 3.0));
+}
+
 }  // namespace
 }  // namespace dlslot::backend

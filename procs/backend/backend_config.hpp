@@ -130,9 +130,10 @@ struct BackendConfig {
   // A pedestrian's (any non-vehicle's) velocity: the line through its boxes of the last this many
   // seconds, the window's and those that left it; the window's alone when shorter.
   double walker_line_span_s = 0.0;
-  // A still pedestrian is judged again at every frame by its line: dynamic when faster than
-  // static_max_speed and this many standard deviations of the fit (0: never).
-  double walker_switch_min_sigmas = 0.0;
+  // A still object is judged again at every frame, a pedestrian by its line, a vehicle by what its
+  // points measured over the last frames: dynamic when faster than static_max_speed and this many
+  // standard deviations of that velocity (0: never).
+  double switch_min_sigmas = 0.0;
   double dynamic_min_sigmas = 2.0;
   // A landmark turns dynamic when its last `switch_frames` observations each lie farther than
   // `switch_distance` (m, bird's-eye) from it (a parked car pulls out).

@@ -1,5 +1,6 @@
 #include "backend/motion_evidence.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -94,6 +95,18 @@ Eigen::Vector3d velocityAlongHeading(const SpeedFit& fit, const Eigen::Vector2d&
   Eigen::Vector3d out = fit.velocity;
   out.head<2>() -= (1.0 - w) * v_across * across;
   return out;
+}
+
+double sigmasOnOneAxis(double plane_sigmas) {
+  // erfc(k1 / sqrt 2) falls from 1 to 0 as k1 grows; bisect for exp(-k^2 / 2) in [0, k] (the one
+  // axis needs no more sigmas than the plane).
+  const double p = std::exp(-0.5 * plane_sigmas * plane_sigmas);
+  double lo = 0, hi = std::max(plane_sigmas, 0.0);
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (std::erfc(mid / std::sqrt(2.0)) > p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
 }
 
 bool leftLandmark(const std::vector<Eigen::Vector3d>& positions, const Eigen::Vector3d& landmark, double distance,

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <optional>
 #include <vector>
 
@@ -43,6 +44,23 @@ Eigen::Vector3d velocityAlongHeading(const SpeedFit& fit, const Eigen::Vector2d&
 inline bool movesBeyond(double speed, double sigma, double min_speed, double min_sigmas) {
   return speed > min_speed && speed > min_sigmas * sigma;
 }
+
+// The same for a bird's-eye velocity with its covariance: its speed against its standard deviation
+// along it.
+inline bool movesBeyond(const Eigen::Vector2d& velocity, const Eigen::Matrix2d& covariance, double min_speed,
+                        double min_sigmas) {
+  const double speed = velocity.norm();
+  return speed > 0 &&
+         movesBeyond(speed, std::sqrt(velocity.dot(covariance * velocity)) / speed, min_speed, min_sigmas);
+}
+
+// The same evidence on one axis. A still object's fitted velocity is noise of sigma per axis: its
+// speed in the plane exceeds k sigmas with probability exp(-k^2 / 2) (Rayleigh), one component
+// exceeds k1 sigmas with probability erfc(k1 / sqrt 2). Returns the k1 of the same probability
+// (k = 2: 13.5 %, k1 = 1.49). A vehicle moves along its heading, so only the fit's component along
+// it is evidence of motion; tested there, a still car is called moving no more often than in the
+// plane, and a moving one is seen sooner.
+double sigmasOnOneAxis(double plane_sigmas);
 
 // True when the last `n` positions all lie farther than `distance` (bird's-eye) from `landmark`
 // (false when there are fewer than n).

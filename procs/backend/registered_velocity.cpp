@@ -1,5 +1,7 @@
 #include "backend/registered_velocity.hpp"
 
+#include <cmath>
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
@@ -75,6 +77,23 @@ FusedVelocity fuseVelocities(const Eigen::Vector2d& line_velocity, const Eigen::
   out.covariance = info.inverse();
   out.used = used;
   return out;
+}
+
+bool measuredMotion(const std::vector<VelocityEvidence>& evidence, double min_speed, double min_sigmas) {
+  Eigen::Matrix2d info = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d eta = Eigen::Vector2d::Zero();
+  for (const VelocityEvidence& e : evidence) {
+    info += e.information;
+    eta += e.information * e.velocity;
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(0.5 * (info + info.transpose()));
+  for (int k = 0; k < 2; ++k) {
+    const double l = es.eigenvalues()[k];
+    if (!(l > 0)) continue;
+    const double speed = std::abs(es.eigenvectors().col(k).dot(eta)) / l;  // along it, sigma 1 / sqrt(l)
+    if (speed > min_speed && speed > min_sigmas / std::sqrt(l)) return true;
+  }
+  return false;
 }
 
 }  // namespace dlslot::backend

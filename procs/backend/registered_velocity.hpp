@@ -41,4 +41,10 @@ struct FusedVelocity {
 FusedVelocity fuseVelocities(const Eigen::Vector2d& line_velocity, const Eigen::Matrix2d& line_covariance,
                              const std::vector<VelocityEvidence>& registered);
 
+// Evidence that an object moves from velocities alone: along some direction they measured, the
+// information-weighted mean speed exceeds min_speed and min_sigmas of its standard deviation. A
+// still vehicle seen end-on measures its motion along the line of sight only; its other direction
+// is noise and counts for nothing.
+bool measuredMotion(const std::vector<VelocityEvidence>& evidence, double min_speed, double min_sigmas);
+
 }  // namespace dlslot::backend

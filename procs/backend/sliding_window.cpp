@@ -3,6 +3,7 @@
 #include <ceres/loss_function.h>
 
 #include <chrono>
+#include <limits>
 #include <stdexcept>
 
 #include "backend/constant_acceleration_factor.hpp"
@@ -432,29 +433,35 @@ std::optional<SlidingWindow::LineVelocity> SlidingWindow::boxLineVelocity(const 
   return line;
 }
 
-SlidingWindow::LineVelocity SlidingWindow::youngVehicleVelocity(const Track& track, const LineVelocity& line) const {
+std::vector<VelocityEvidence> SlidingWindow::pointsVelocities(const Track& track, int first_frame) const {
   // The ego's per-frame translation error: the odometry factor's sigma (eq. 8).
   const double ego_sigma = 0.5 * (config_.odometry_sigma[0] + config_.odometry_sigma[1]);
-  std::vector<VelocityEvidence> registered;
-  for (const auto& [f, motion] : track.motions) {
+  std::vector<VelocityEvidence> measured;
+  for (auto it = track.motions.lower_bound(first_frame); it != track.motions.end(); ++it) {
+    const int f = it->first;
     const auto prev = track.observations.find(f - 1);
     const EgoFrame *a = findFrame(f - 1), *b = findFrame(f);
     if (prev == track.observations.end() || !a || !b) continue;
     const double dt = 1e-6 * static_cast<double>(b->utime - a->utime);
     const Eigen::Vector3d p_prev = fromBlock(a->pose->data()) * prev->second.b.translation();
-    if (const auto v = registeredVelocity(motion.M, motion.information, p_prev, dt, ego_sigma)) registered.push_back(*v);
+    if (const auto v = registeredVelocity(it->second.M, it->second.information, p_prev, dt, ego_sigma))
+      measured.push_back(*v);
   }
-  if (registered.empty()) {
-    // Far away: the face's speed along the line of sight over the last pairs, if any.
-    const int t = frames_.back().frame;
-    std::vector<SightSpeed> pairs;
-    const auto first = track.sight_speeds.lower_bound(t - config_.line_of_sight_pairs + 1);
-    for (auto it = first; it != track.sight_speeds.end(); ++it) pairs.push_back(it->second);
-    if (const auto sight = lineOfSightVelocity(pairs, config_.line_of_sight_sigma, config_.line_of_sight_min_points))
-      registered.push_back(*sight);
-  }
-  if (registered.empty()) return line;
-  const FusedVelocity fused = fuseVelocities(line.velocity.head<2>(), line.covariance, registered);
+  if (!measured.empty()) return measured;
+  // Far away: the face's speed along the line of sight over the last pairs, if any.
+  const int t = frames_.back().frame;
+  std::vector<SightSpeed> pairs;
+  const auto first = track.sight_speeds.lower_bound(t - config_.line_of_sight_pairs + 1);
+  for (auto it = first; it != track.sight_speeds.end(); ++it) pairs.push_back(it->second);
+  if (const auto sight = lineOfSightVelocity(pairs, config_.line_of_sight_sigma, config_.line_of_sight_min_points))
+    measured.push_back(*sight);
+  return measured;
+}
+
+SlidingWindow::LineVelocity SlidingWindow::youngVehicleVelocity(const Track& track, const LineVelocity& line) const {
+  const std::vector<VelocityEvidence> measured = pointsVelocities(track, std::numeric_limits<int>::min());
+  if (measured.empty()) return line;
+  const FusedVelocity fused = fuseVelocities(line.velocity.head<2>(), line.covariance, measured);
   LineVelocity out = line;
   out.velocity.head<2>() = fused.velocity;
   out.covariance = fused.covariance;
@@ -467,8 +474,17 @@ void SlidingWindow::startTrack(Track& track, int frame) {
   const auto moving = [&](double speed, double sigma) {
     return movesBeyond(speed, sigma, config_.static_max_speed, config_.dynamic_min_sigmas);
   };
-  const std::optional<SpeedFit> fit = windowMotion(track, windowHeading(track));
-  bool dynamic = fit ? moving(fit->speed, fit->sigma) : track.dynamic_guess;
+  const std::optional<WindowHeading> heading = windowHeading(track);
+  const std::optional<SpeedFit> fit = windowMotion(track, heading);
+  bool dynamic = track.dynamic_guess;
+  if (fit && heading)
+    // A vehicle: its speed along its heading, the sideways part being noise (motion_evidence.hpp).
+    // Far cars creeping at 1-3 m/s in a queue, 80-105 m away, fitted at 1.4-1.5 sigmas there but
+    // not 2 in the plane, were published still for their first 2-4 frames (highway-jam 10).
+    dynamic = movesBeyond(std::abs(fit->velocity.head<2>().dot(heading->direction)), fit->sigma,
+                          config_.static_max_speed, sigmasOnOneAxis(config_.dynamic_min_sigmas));
+  else if (fit)
+    dynamic = moving(fit->speed, fit->sigma);
   // A vehicle whose points measured its motion (registrations, the line of sight): that motion
   // fused with its boxes' line bounds its speed far more tightly than 3-4 boxes do. Queues' vans
   // and trucks creeping at 1-3 m/s were started static by their boxes and published still for
@@ -476,9 +492,7 @@ void SlidingWindow::startTrack(Track& track, int frame) {
   if (!dynamic && isVehicle(track.type) && (!track.motions.empty() || !track.sight_speeds.empty()))
     if (const std::optional<LineVelocity> line = boxLineVelocity(track)) {
       const LineVelocity v = youngVehicleVelocity(track, *line);
-      const Eigen::Vector2d h = v.velocity.head<2>();
-      const double speed = h.norm();
-      if (speed > 0) dynamic = moving(speed, std::sqrt(h.dot(v.covariance * h)) / speed);
+      dynamic = movesBeyond(v.velocity.head<2>(), v.covariance, config_.static_max_speed, config_.dynamic_min_sigmas);
     }
   track.model = dynamic ? TrackModel::kDynamic : TrackModel::kStatic;
   if (!dynamic) newBlock(track.landmark, fromBlock(frames_.back().pose->data()) * track.observations.at(frame).b);
@@ -583,9 +597,15 @@ int SlidingWindow::switchMovingLandmarks() {
                               config_.switch_frames);
     // A walker started still on its first 3-4 boxes is judged again at every frame by its line: it
     // seldom leaves its landmark by switch_distance, as the landmark follows its boxes.
-    if (!moved && !isVehicle(track.type) && config_.walker_switch_min_sigmas > 0)
+    if (!moved && !isVehicle(track.type) && config_.switch_min_sigmas > 0)
       if (const std::optional<SpeedFit> fit = windowMotion(track, std::nullopt))
-        moved = movesBeyond(fit->speed, fit->sigma, config_.static_max_speed, config_.walker_switch_min_sigmas);
+        moved = movesBeyond(fit->speed, fit->sigma, config_.static_max_speed, config_.switch_min_sigmas);
+    // A still vehicle is judged again at every frame by its points: their registrations of the last
+    // frames measure a car pulling away from a stop, or creeping at 1 m/s with its landmark
+    // following its boxes, frames before those boxes leave the landmark.
+    if (!moved && isVehicle(track.type) && config_.switch_min_sigmas > 0)
+      moved = measuredMotion(pointsVelocities(track, frames_.back().frame - config_.line_of_sight_pairs + 1),
+                             config_.static_max_speed, config_.switch_min_sigmas);
     if (moved) {
       makeDynamic(track);
       ++switched;

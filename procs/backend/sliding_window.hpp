@@ -26,6 +26,7 @@
 #include "backend/motion_evidence.hpp"
 #include "backend/object_model.hpp"
 #include "backend/pose_manifold.hpp"
+#include "backend/registered_velocity.hpp"
 #include "backend/track_front.hpp"
 #include "backend/window_solver.hpp"
 
@@ -140,6 +141,9 @@ class SlidingWindow {
   // measured (registered_velocity.hpp); without registrations, with its speed along the line of
   // sight over its last scan pairs (line_of_sight.hpp); else the line as it is.
   LineVelocity youngVehicleVelocity(const Track& track, const LineVelocity& line) const;
+  // The velocities over ground its points measured: its registrations from first_frame on
+  // (registered_velocity.hpp), else its face's speed along the line of sight over the last pairs.
+  std::vector<VelocityEvidence> pointsVelocities(const Track& track, int first_frame) const;
   // A vehicle's bird's-eye heading over the window and its standard deviation (rad): the mean of
   // its boxes' and its faces' headings (face_heading.hpp), each weighted by its inverse variance;
   // none for other classes.

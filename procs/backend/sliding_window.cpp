@@ -471,9 +471,6 @@ SlidingWindow::LineVelocity SlidingWindow::youngVehicleVelocity(const Track& tra
 void SlidingWindow::startTrack(Track& track, int frame) {
   // Static or dynamic from the positions of the trajectory in the window (III-D); the tracker's
   // guess only when the window has too little of it.
-  const auto moving = [&](double speed, double sigma) {
-    return movesBeyond(speed, sigma, config_.static_max_speed, config_.dynamic_min_sigmas);
-  };
   const std::optional<WindowHeading> heading = windowHeading(track);
   const std::optional<SpeedFit> fit = windowMotion(track, heading);
   bool dynamic = track.dynamic_guess;
@@ -484,7 +481,7 @@ void SlidingWindow::startTrack(Track& track, int frame) {
     dynamic = movesBeyond(std::abs(fit->velocity.head<2>().dot(heading->direction)), fit->sigma,
                           config_.static_max_speed, sigmasOnOneAxis(config_.dynamic_min_sigmas));
   else if (fit)
-    dynamic = moving(fit->speed, fit->sigma);
+    dynamic = movesBeyond(fit->speed, fit->sigma, config_.static_max_speed, config_.dynamic_min_sigmas);
   // A vehicle whose points measured its motion (registrations, the line of sight): that motion
   // fused with its boxes' line bounds its speed far more tightly than 3-4 boxes do. Queues' vans
   // and trucks creeping at 1-3 m/s were started static by their boxes and published still for

@@ -701,6 +701,6 @@ TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
   expectRefused("walker_line_span_s", "-1");
   EXPECT_EQ(c.switch_min_sigmas, 3.0);
   expectRefused("switch_min_sigmas", "-1");
-  EXPECT_EQ(c.vehicle_lateral_acceleration, 1.0);
-  for (const char* bad : {"-1", "fast"}) expectRefused("vehicle_lateral_acceleration", bad);
+  EXPECT_EQ(c.vehicle_acceleration, 1.0);
+  for (const char* bad : {"-1", "fast"}) expectRefused("vehicle_acceleration", bad);
 }

@@ -475,3 +475,36 @@ TEST(EvalTracking, VelocityErrorsAreBrokenDownByAgeClassMotionAndStretch) {
   EXPECT_EQ(find("frames", "000-001").pairs, 2);
   EXPECT_NEAR(*find("frames", "018-019").rmse_mps, std::sqrt((2 * 1.0 + 2 * 4.0) / 4), 1e-12);
 }
+
+TEST(EvalVelocity, TheTracksCovarianceIsCheckedAgainstItsErrors) {
+  // A car tracked for 10 frames, 1 m/s too fast along x, its track's velocity covariance
+  // diag(0.25, 1) from frame 2 on (sigma 0.5 m/s along x: NEES (1 / 0.5)^2 = 4, inside the 95 %
+  // ellipse), diag(0.04, 1) from frame 6 on (sigma 0.2: NEES 25, outside it); frames 0-1 without
+  // one; a parked car's pair never counts.
+  std::vector<TrackingFrame> frames;
+  for (int t = 0; t < 10; ++t) {
+    TrackingFrame f;
+    f.frame = t;
+    Object g = obj(10, 0, 1), h = obj(10, 0, 101), parked = obj(30, 5, 2), parked_track = obj(30, 5, 102);
+    g.velocity = Eigen::Vector2d(10, 0);
+    g.dynamic = true;
+    h.velocity = Eigen::Vector2d(11, 0);
+    if (t >= 2) h.velocity_covariance = Eigen::Vector2d(t >= 6 ? 0.04 : 0.25, 1.0).asDiagonal();
+    parked.velocity = parked_track.velocity = Eigen::Vector2d::Zero();
+    parked_track.velocity_covariance = Eigen::Matrix2d::Identity();
+    f.truth = {g, parked};
+    f.tracks = {h, parked_track};
+    frames.push_back(f);
+  }
+  const ClearMot m = evaluateClearMot(frames, kDistance);
+  ASSERT_EQ(m.velocities.size(), 20u);
+  EXPECT_FALSE(m.velocities[0].nees());
+  const VelocityCalibration all = velocityCalibration(m.velocities, 0, 100);
+  EXPECT_EQ(all.pairs, 8);
+  EXPECT_NEAR(*all.nees_mean, (4 * 4.0 + 4 * 25.0) / 8, 1e-9);
+  EXPECT_NEAR(*all.within_95, 0.5, 1e-12);
+  const VelocityCalibration young = velocityCalibration(m.velocities, 0, 4);  // frames 2-4
+  EXPECT_EQ(young.pairs, 3);
+  EXPECT_NEAR(*young.within_95, 1.0, 1e-12);
+  EXPECT_FALSE(velocityCalibration(m.velocities, 20, 100).nees_mean);
+}

@@ -299,6 +299,8 @@ slot_state_t slotState(int frame, const std::vector<int>& ids) {
     t.pose = poseAt(10 + frame + id, 0);
     t.size[0] = 4, t.size[1] = 2, t.size[2] = 1.5;
     t.velocity[0] = 3, t.velocity[1] = 4;
+    t.velocity_covariance[0] = t.velocity_covariance[4] = 0.04;  // 0.2 m/s along any direction
+    t.velocity_covariance[8] = 0.01;
     t.is_dynamic = true;
     t.status = track_t::STATUS_CONFIRMED;
     m.tracks.push_back(t);
@@ -348,7 +350,7 @@ TEST(FoxgloveConvert, SlotStateGivesTransformPathAndTracksWithRecentPaths) {
   ASSERT_EQ(tracks["entities"].size(), 1u);  // track 1 ended
   const YAML::Node e = tracks["entities"][0];
   EXPECT_EQ(e["id"].as<std::string>(), "track/2");
-  EXPECT_EQ(e["texts"][0]["text"].as<std::string>(), "2 Car 5.0 m/s");
+  EXPECT_EQ(e["texts"][0]["text"].as<std::string>(), "2 Car 5.0±0.2 m/s");
   ASSERT_EQ(e["lines"].size(), 1u);
   EXPECT_EQ(e["lines"][0]["points"].size(), 3u);  // the last 3 positions
   EXPECT_DOUBLE_EQ(e["lines"][0]["points"][2]["x"].as<double>(), 16);

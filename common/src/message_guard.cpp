@@ -15,7 +15,7 @@ constexpr size_t kPose = 7 * kF64;
 constexpr size_t kMinString = kI32 + 1;  // length (>= 1) and the terminating NUL
 constexpr size_t kMinBox = kMinString + kI32 + 8 * kF64;
 constexpr size_t kMinTiming = kMinString + kF64;
-constexpr size_t kMinTrack = kI32 + kMinString + kPose + 9 * kF64 + kI8 + 36 * kF64 + 3 * kI32 + kI8 + kF64;
+constexpr size_t kMinTrack = kI32 + kMinString + kPose + 18 * kF64 + kI8 + 36 * kF64 + 3 * kI32 + kI8 + kF64;
 constexpr size_t kMinLoopEvent = 2 * kI32 + kPose + 3 * kF64 + kI8 + kMinString;
 constexpr size_t kMinAssociation = 3 * kI32 + kI8 + 2 * kMinBox + kI8 + 3 * kF64 + kI8 + kF64 + kI8 + kF64;
 
@@ -120,7 +120,7 @@ bool timings(Cursor& c) {
 
 bool track(Cursor& c) {
   return c.skip(kI32, "track.id") && c.str("track.type") && pose(c, "track.pose") &&
-         c.skip(9 * kF64 + kI8 + 36 * kF64 + 3 * kI32 + kI8 + kF64, "track");
+         c.skip(18 * kF64 + kI8 + 36 * kF64 + 3 * kI32 + kI8 + kF64, "track");
 }
 
 bool association(Cursor& c) {
@@ -399,6 +399,7 @@ Refusal checkContent(const slot_state_t& m) {
       if (t.size[k] <= 0)
         return {"bad_size", f + ".size[" + std::to_string(k) + "] = " + std::to_string(t.size[k]) + ", expected > 0"};
     if (Refusal r = checkFinite(t.velocity, 3, f + ".velocity")) return r;
+    if (Refusal r = checkFinite(t.velocity_covariance, 9, f + ".velocity_covariance")) return r;
     if (Refusal r = checkFinite(t.angular_velocity, 3, f + ".angular_velocity")) return r;
     if (Refusal r = checkFinite(t.covariance, 36, f + ".covariance")) return r;
     if (Refusal r = checkNonNegative(t.age, "tracks.age")) return r;

@@ -79,8 +79,8 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   s.get("observation_sigma_growth_per_m", c.observation_sigma_growth_per_m);
   c.vehicle_motion_sigma = readSigmas<4>(s, "vehicle_motion_sigma", "lateral m, vertical m, roll rad, pitch rad");
   s.get("vehicle_types", c.vehicle_types);
-  s.get("vehicle_lateral_acceleration", c.vehicle_lateral_acceleration);
-  require(c.vehicle_lateral_acceleration >= 0.0, s, "vehicle_lateral_acceleration", "an acceleration >= 0 (m/s^2)");
+  s.get("vehicle_acceleration", c.vehicle_acceleration);
+  require(c.vehicle_acceleration >= 0.0, s, "vehicle_acceleration", "an acceleration >= 0 (m/s^2)");
   ConfigSection headings = s.section("heading_sigma_by_type");
   for (const std::string& type : headings.keys()) {
     const double sigma = headings.get<double>(type);

@@ -46,9 +46,11 @@ struct BackendConfig {
   // the classes it applies to.
   Eigen::Vector4d vehicle_motion_sigma = Eigen::Vector4d(0.02, 0.02, 0.002, 0.002);
   std::vector<std::string> vehicle_types = {"Car", "Van", "Truck", "Tram", "Cyclist"};
-  // A vehicle's chain starts straight: the yaw rate of its first pose change is zero-mean with
-  // sigma this lateral acceleration (m/s^2) over its speed (vehicle_motion_factor.hpp); 0: free.
-  double vehicle_lateral_acceleration = 0.0;
+  // The RMS acceleration of moving vehicles (m/s^2), sideways and along. A vehicle's chain starts
+  // straight: the yaw rate of its first pose change is zero-mean with sigma this over its speed
+  // (vehicle_motion_factor.hpp). A registered velocity of t seconds ago may have changed by this x t
+  // (registered_velocity.hpp). 0: neither.
+  double vehicle_acceleration = 0.0;
   // A detector's heading is as good as its class lets it be: per class, the rz sigma of its
   // boxes when that is more than observation_sigma's (landmark_sigma's) rz.
   std::map<std::string, double> heading_sigma_by_type;

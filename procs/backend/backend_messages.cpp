@@ -54,6 +54,7 @@ slot_state_t toMsg(const BackendOutput& out, const std::string& mode) {
       t.size[i] = e.size[i];
       t.velocity[i] = e.velocity[i];
       t.angular_velocity[i] = e.angular_velocity[i];
+      for (int j = 0; j < 3; ++j) t.velocity_covariance[3 * i + j] = e.velocity_covariance(i, j);
     }
     t.is_dynamic = e.dynamic;
     dlslot::toMsg(e.covariance, t.covariance);

@@ -10,7 +10,8 @@
 namespace dlslot::backend {
 
 std::optional<VelocityEvidence> registeredVelocity(const Pose& M, const Matrix6& information,
-                                                   const Eigen::Vector3d& p_prev, double dt, double ego_sigma_m) {
+                                                   const Eigen::Vector3d& p_prev, double dt, double ego_sigma_m,
+                                                   double change_sigma_mps) {
   if (!(dt > 0)) return std::nullopt;
   // The measurement as a pose change of a frame at the centre with the world's axes: its
   // translation is the centre's displacement, in world axes.
@@ -36,8 +37,8 @@ std::optional<VelocityEvidence> registeredVelocity(const Pose& M, const Matrix6&
   for (int k = 0; k < 2; ++k) {
     const double lambda = ed.eigenvalues()[k];
     if (!(lambda > 1e-9 * d_max)) continue;
-    const double var_d = 1.0 / lambda + ego_sigma_m * ego_sigma_m;
-    info_v += ed.eigenvectors().col(k) * ed.eigenvectors().col(k).transpose() * (dt * dt / var_d);
+    const double var_v = (1.0 / lambda + ego_sigma_m * ego_sigma_m) / (dt * dt) + change_sigma_mps * change_sigma_mps;
+    info_v += ed.eigenvectors().col(k) * ed.eigenvectors().col(k).transpose() / var_v;
   }
   VelocityEvidence v;
   v.velocity = ((M * p_prev - p_prev) / dt).head<2>();

@@ -25,9 +25,13 @@ struct VelocityEvidence {
 // (`information`, world tangent of M: translation then rotation) carried to the centre's
 // displacement with the rotation marginalized, then the ego's per-frame translation error
 // (ego_sigma_m per axis, it moves both scans' points against each other) added to each measured
-// direction. Nothing when dt <= 0 or no horizontal direction was measured.
+// direction. As a measurement of the velocity some time later, the velocity's possible change
+// since (change_sigma_mps per axis: a vehicle accelerating at its RMS acceleration over that
+// time) adds to each measured direction's variance too. Nothing when dt <= 0 or no horizontal
+// direction was measured.
 std::optional<VelocityEvidence> registeredVelocity(const Pose& M, const Matrix6& information,
-                                                   const Eigen::Vector3d& p_prev, double dt, double ego_sigma_m);
+                                                   const Eigen::Vector3d& p_prev, double dt, double ego_sigma_m,
+                                                   double change_sigma_mps = 0.0);
 
 // The information-weighted mean of a line's velocity (covariance line_covariance, full rank) and
 // registered velocities. A registration whose velocity disagrees with the line beyond the

@@ -421,6 +421,7 @@ std::optional<SlidingWindow::LineVelocity> SlidingWindow::boxLineVelocity(const 
   line.velocity = fit->velocity;
   const double var_fit = std::max(fit->sigma * fit->sigma, 1e-6);
   line.covariance = var_fit * Eigen::Matrix2d::Identity();
+  line.vertical_variance = var_fit;
   if (!window_heading) return line;
   const Eigen::Vector2d& heading = window_heading->direction;
   const double heading_sigma = window_heading->sigma;
@@ -444,7 +445,10 @@ std::vector<VelocityEvidence> SlidingWindow::pointsVelocities(const Track& track
     if (prev == track.observations.end() || !a || !b) continue;
     const double dt = 1e-6 * static_cast<double>(b->utime - a->utime);
     const Eigen::Vector3d p_prev = fromBlock(a->pose->data()) * prev->second.b.translation();
-    if (const auto v = registeredVelocity(it->second.M, it->second.information, p_prev, dt, ego_sigma))
+    // It measured the mean velocity over frames f-1..f; the newest frame's velocity is asked for.
+    const double age = secondsBetween(f, frames_.back().frame) + 0.5 * dt;
+    if (const auto v = registeredVelocity(it->second.M, it->second.information, p_prev, dt, ego_sigma,
+                                          config_.vehicle_acceleration * age))
       measured.push_back(*v);
   }
   if (!measured.empty()) return measured;
@@ -573,11 +577,11 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
 
 void SlidingWindow::startStraight(const Track& track, int f, double* change, const Eigen::Vector3d& displacement) {
   const double dt = secondsBetween(f - 1, f);
-  if (config_.vehicle_lateral_acceleration <= 0 || !(dt > 0)) return;
+  if (config_.vehicle_acceleration <= 0 || !(dt > 0)) return;
   // Its speed: the track's velocity when it has one, else this first change's. Below 1 m/s a
   // vehicle may turn on the spot as far as this prior is concerned.
   const double speed = track.velocity ? track.velocity->head<2>().norm() : displacement.head<2>().norm() / dt;
-  const double sigma_rz = config_.vehicle_lateral_acceleration * dt / std::max(speed, 1.0);
+  const double sigma_rz = config_.vehicle_acceleration * dt / std::max(speed, 1.0);
   addFactor(VehicleMotionFactor::StartingStraight(sigma_rz), false, {change});
 }
 
@@ -719,7 +723,10 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
         // turn (intersection seeds 3 and 10: 6 and 18 errors > 3 m/s; none with the line), and the
         // line is better on the tuning seeds 1-5 (pedestrian velocity RMSE 0.308 / 0.442 / 0.657 /
         // 0.489 / 0.474 -> 0.296 / 0.422 / 0.413 / 0.415 / 0.422 m/s).
-        if (const auto line = boxLineVelocity(track)) track.velocity = line->velocity;
+        if (const auto line = boxLineVelocity(track)) {
+          track.velocity = line->velocity;
+          track.velocity_covariance = line->covariance3();
+        }
       } else if (static_cast<int>(track.changes.size()) >= config_.window_size - 1) {
         // The linear velocity from the chain (eq. 10-11 and the constant-acceleration factor smooth
         // it) once the chain spans the window: from then on the marginalization prior carries its
@@ -736,15 +743,28 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
         if (span > 0) {
           track.velocity = (fromBlock(last->second->data()).translation() - fromBlock(first->second->data()).translation()) / span;
           track.velocity_from_chain = true;
+          // Its covariance from the two poses' joint one; their tangents' translations are the
+          // world's (pose_manifold.hpp), so the difference's is C_ll + C_ff - C_lf - C_fl.
+          if (config_.compute_covariance)
+            if (const auto C = solver_.jointCovariance({first->second->data(), last->second->data()}))
+              track.velocity_covariance = (C->block<3, 3>(0, 0) + C->block<3, 3>(6, 6) - C->block<3, 3>(0, 6) -
+                                           C->block<3, 3>(6, 0)) / (span * span);
         }
       } else if (!track.velocity_from_chain) {
         // Young: the line through its boxes in the window (evidence before initialization
         // included), turned toward their heading for a vehicle. A track whose chain the window
         // has cut short (coasting, or leaving) keeps the velocity its chain last gave. Its points'
         // registrations, when it has any, measure the same motion far better than 2-9 boxes.
-        if (const auto line = boxLineVelocity(track)) track.velocity = youngVehicleVelocity(track, *line).velocity;
+        if (const auto line = boxLineVelocity(track)) {
+          const LineVelocity v = youngVehicleVelocity(track, *line);
+          track.velocity = v.velocity;
+          track.velocity_covariance = v.covariance3();
+        }
       }
-      if (track.velocity) e.velocity = *track.velocity;
+      if (track.velocity) {
+        e.velocity = *track.velocity;
+        e.velocity_covariance = track.velocity_covariance;
+      }
       e.angular_velocity = track.angular_velocity;
       if (track.velocity) track.front = withMotion(track.front, track.velocity->head<2>(), e.pose.linear().col(0).head<2>());
     }

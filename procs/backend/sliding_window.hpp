@@ -81,6 +81,7 @@ class SlidingWindow {
     // The motion last estimated (world frame): kept while the window holds too little of the
     // chain to estimate it again (coasting, or about to leave).
     std::optional<Eigen::Vector3d> velocity;
+    Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();  // of `velocity`, (m/s)^2
     bool velocity_from_chain = false;
     TrackFront front;  // which end its boxes' heading points to (track_front.hpp)
     // Per-object registration: the object's accumulated points (its model, world frame of its
@@ -135,6 +136,13 @@ class SlidingWindow {
   struct LineVelocity {
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
     Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity();  // bird's-eye
+    double vertical_variance = 1.0;  // of the velocity's upward part
+    Eigen::Matrix3d covariance3() const {
+      Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
+      c.topLeftCorner<2, 2>() = covariance;
+      c(2, 2) = vertical_variance;
+      return c;
+    }
   };
   std::optional<LineVelocity> boxLineVelocity(const Track& track) const;
   // A young vehicle's line velocity fused with the velocities its registrations in the window

@@ -388,25 +388,39 @@ WindowSolver::Summary WindowSolver::solve(const std::vector<const Factor*>& fact
 }
 
 std::optional<Matrix6> WindowSolver::covariance(const double* block) const {
-  auto it = where_.find(block);
-  if (it == where_.end() || tail_cov_.size() == 0) return std::nullopt;
-  const Slot& s = it->second;
-  const int tail_start = n_sep_ - tail_dim_;
-  if (s.group < 0) {
-    if (6 * s.index < tail_start) return std::nullopt;
-    return Matrix6(tail_cov_.block<6, 6>(6 * s.index - tail_start, 6 * s.index - tail_start));
+  const std::optional<Eigen::MatrixXd> cov = jointCovariance({block});
+  if (!cov) return std::nullopt;
+  return Matrix6(*cov);
+}
+
+std::optional<Eigen::MatrixXd> WindowSolver::jointCovariance(const std::vector<const double*>& blocks) const {
+  if (tail_cov_.size() == 0 || blocks.empty()) return std::nullopt;
+  std::vector<const Slot*> slots;
+  for (const double* block : blocks) {
+    auto it = where_.find(block);
+    if (it == where_.end() || it->second.group != where_.at(blocks.front()).group) return std::nullopt;
+    slots.push_back(&it->second);
   }
-  // Group block: Sigma = [H_k^-1]_bb + W Sigma_tail W^T with W = [H_k^-1 C_k]_b over the
-  // tail blocks the group touches.
-  const Group& g = groups_[s.group];
-  auto solve = [&g](RowMatrix B) {
-    g.chol.solveL(B);
-    g.chol.solveLt(B);
-    return B;
-  };
-  RowMatrix E = RowMatrix::Zero(6 * g.m, 6);
-  E.middleRows<6>(6 * s.index).setIdentity();
-  Matrix6 cov = solve(E).middleRows<6>(6 * s.index);
+  const int n = static_cast<int>(blocks.size());
+  const int tail_start = n_sep_ - tail_dim_;
+  Eigen::MatrixXd cov(6 * n, 6 * n);
+  if (slots.front()->group < 0) {
+    for (int a = 0; a < n; ++a)
+      if (slots[a]->group == -2 || 6 * slots[a]->index < tail_start) return std::nullopt;
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b)
+        cov.block<6, 6>(6 * a, 6 * b) =
+            tail_cov_.block<6, 6>(6 * slots[a]->index - tail_start, 6 * slots[b]->index - tail_start);
+    return cov;
+  }
+  // Group blocks: Sigma = [H_k^-1]_ab + W_a Sigma_tail W_b^T with W = [H_k^-1 C_k] over the tail
+  // blocks the group touches.
+  const Group& g = groups_[slots.front()->group];
+  RowMatrix E = RowMatrix::Zero(6 * g.m, 6 * n);
+  for (int a = 0; a < n; ++a) E.block<6, 6>(6 * slots[a]->index, 6 * a).setIdentity();
+  g.chol.solveL(E);
+  g.chol.solveLt(E);  // the columns of H_k^-1
+  for (int a = 0; a < n; ++a) cov.middleRows<6>(6 * a) = E.middleRows<6>(6 * slots[a]->index);
   std::vector<int> cols, tail_offsets;
   for (size_t a = 0; a < g.touched.size(); ++a)
     if (6 * g.touched[a] >= tail_start) {
@@ -422,8 +436,9 @@ std::optional<Matrix6> WindowSolver::covariance(const double* block) const {
       Sigma.block<6, 6>(6 * a, 6 * b) = tail_cov_.block<6, 6>(tail_offsets[a], tail_offsets[b]);
   }
   g.chol.solveLt(W);
-  const Eigen::MatrixXd W_b = W.middleRows<6>(6 * s.index);
-  cov += W_b * Sigma * W_b.transpose();
+  Eigen::MatrixXd W_blocks(6 * n, W.cols());
+  for (int a = 0; a < n; ++a) W_blocks.middleRows<6>(6 * a) = W.middleRows<6>(6 * slots[a]->index);
+  cov += W_blocks * Sigma * W_blocks.transpose();
   return cov;
 }
 

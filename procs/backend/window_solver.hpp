@@ -52,6 +52,9 @@ class WindowSolver {
   // the separator's tail blocks; for a group block, exact when every separator block the group
   // touches is in the tail, else without the correlations through the others.
   std::optional<Matrix6> covariance(const double* block) const;
+  // The joint marginal covariance of blocks of one group, or of the separator's tail (6 rows and
+  // columns each, in the order given); none for blocks of different groups.
+  std::optional<Eigen::MatrixXd> jointCovariance(const std::vector<const double*>& blocks) const;
 
  private:
   // Row-major: the substitutions below work on rows of 6x6 blocks.

@@ -1,6 +1,7 @@
 #include "metrics_report.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -60,6 +61,8 @@ std::vector<std::pair<std::string, Opt>> trackingValues(const std::optional<Trac
   if (t)
     for (const VelocityGroup& g : t->velocity_groups)
       if (g.dimension == "age" && g.bin == "0-4") young = g.rmse_mps;
+  const VelocityCalibration all = t ? velocityCalibration(t->clear.velocities, 0, INT_MAX) : VelocityCalibration{};
+  const VelocityCalibration young_calibration = t ? velocityCalibration(t->clear.velocities, 0, 4) : VelocityCalibration{};
   return {{"mota", t ? t->clear.mota : std::nullopt},
           {"motp_m", t ? t->clear.motp_m : std::nullopt},
           {"idsw", count(&ClearMot::idsw)},
@@ -68,6 +71,9 @@ std::vector<std::pair<std::string, Opt>> trackingValues(const std::optional<Trac
           {"hota", t && t->hota ? Opt(t->hota->hota) : std::nullopt},
           {"velocity_rmse_mps", t ? t->clear.velocity_rmse_mps : std::nullopt},
           {"velocity_young_rmse_mps", young},
+          {"velocity_nees", all.nees_mean},
+          {"velocity_within_95", all.within_95},
+          {"velocity_young_within_95", young_calibration.within_95},
           {"heading_rmse_deg", t ? t->clear.heading_rmse_deg : std::nullopt},
           {"heading_pairs", count(&ClearMot::heading_pairs)},
           {"heading_reversed", count(&ClearMot::heading_reversed)},
@@ -430,14 +436,27 @@ std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plo
 
 void writeVelocityErrorsCsv(const std::string& path, const Metrics& m) {
   std::ostringstream out;
-  out << "frame_index,label_id,track_id,class,dynamic,track_age,truth_vx,truth_vy,track_vx,track_vy,error_mps\n";
+  // The track's covariance and NEES empty where it gave none.
+  out << "frame_index,label_id,track_id,class,dynamic,track_age,truth_vx,truth_vy,track_vx,track_vy,error_mps,"
+         "track_cov_xx,track_cov_xy,track_cov_yy,nees\n";
   if (m.tracking)
     for (const VelocityPair& p : m.tracking->clear.velocities) {
       char buf[256];
-      std::snprintf(buf, sizeof buf, "%d,%d,%d,%s,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f\n", p.frame_index, p.label_id,
-                    p.track_id, p.type.c_str(),
-                    p.dynamic ? 1 : 0, p.track_age, p.truth.x(), p.truth.y(), p.track.x(), p.track.y(), p.error());
+      std::snprintf(buf, sizeof buf, "%d,%d,%d,%s,%d,%d,%.4f,%.4f,%.4f,%.4f,%.4f,", p.frame_index, p.label_id,
+                    p.track_id, p.type.c_str(), p.dynamic ? 1 : 0, p.track_age, p.truth.x(), p.truth.y(), p.track.x(),
+                    p.track.y(), p.error());
       out << buf;
+      if (const auto& C = p.track_covariance) {
+        std::snprintf(buf, sizeof buf, "%.6g,%.6g,%.6g,", (*C)(0, 0), (*C)(0, 1), (*C)(1, 1));
+        out << buf;
+      } else {
+        out << ",,,";
+      }
+      if (const std::optional<double> nees = p.nees()) {
+        std::snprintf(buf, sizeof buf, "%.4f", *nees);
+        out << buf;
+      }
+      out << "\n";
     }
   writeText(path, out.str());
 }

@@ -47,6 +47,8 @@ RunLog::Tracks tracksOf(const slot_state_t& msg, int track_max_unseen) {
     Object o;
     o.box = world.transformed(lidar_world);
     o.velocity = (lidar_world.linear() * Eigen::Vector3d(t.velocity[0], t.velocity[1], t.velocity[2])).head<2>();
+    const Eigen::Matrix3d C = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(t.velocity_covariance);
+    if (!C.isZero()) o.velocity_covariance = (lidar_world.linear() * C * lidar_world.linear().transpose()).topLeftCorner<2, 2>();
     out.objects.push_back(o);
   }
   return out;

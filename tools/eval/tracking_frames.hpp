@@ -15,6 +15,7 @@ struct Object {
   Box box;                                  // lidar frame of the scan; id = track / label id
   std::optional<Eigen::Vector2d> velocity;  // m/s in the scan's lidar axes (bird's-eye view)
   bool dynamic = false;                     // labels: moving (see velocity.hpp)
+  std::optional<Eigen::Matrix2d> velocity_covariance = std::nullopt;  // (m/s)^2, when the track gave one
 };
 
 struct TrackingFrame {

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <map>
 
+#include <Eigen/Cholesky>
+
 namespace dlslot::eval {
 namespace {
 
@@ -63,6 +65,33 @@ std::vector<VelocityGroup> breakdownVelocityErrors(const std::vector<VelocityPai
     if (motion.count(bin)) out.push_back(summarize("motion", bin, motion[bin]));
   for (auto& [bin, e] : frames) out.push_back(summarize("frames", bin, std::move(e)));
   return out;
+}
+
+std::optional<double> VelocityPair::nees() const {
+  if (!track_covariance) return std::nullopt;
+  const Eigen::LLT<Eigen::Matrix2d> llt(*track_covariance);
+  if (llt.info() != Eigen::Success) return std::nullopt;
+  const Eigen::Vector2d e = truth - track;
+  return e.dot(llt.solve(e));
+}
+
+VelocityCalibration velocityCalibration(const std::vector<VelocityPair>& pairs, int min_age, int max_age) {
+  constexpr double kChiSquare2Dof95 = 5.991;
+  VelocityCalibration c;
+  double sum = 0;
+  int within = 0;
+  for (const VelocityPair& p : pairs) {
+    if (!p.dynamic || p.track_age < min_age || p.track_age > max_age) continue;
+    const std::optional<double> nees = p.nees();
+    if (!nees) continue;
+    ++c.pairs;
+    sum += *nees;
+    within += *nees <= kChiSquare2Dof95;
+  }
+  if (c.pairs == 0) return c;
+  c.nees_mean = sum / c.pairs;
+  c.within_95 = static_cast<double>(within) / c.pairs;
+  return c;
 }
 
 }  // namespace dlslot::eval

@@ -19,7 +19,11 @@ struct VelocityPair {
   bool dynamic = false;  // the label moves (velocity.hpp: markDynamicLabels)
   int track_age = 0;     // scans since the track was first output (0 = its first scan)
   Eigen::Vector2d truth = Eigen::Vector2d::Zero(), track = Eigen::Vector2d::Zero();
+  std::optional<Eigen::Matrix2d> track_covariance = std::nullopt;  // the track's own, when it gave one
   double error() const { return (truth - track).norm(); }
+  // e^T C^-1 e: the squared error in the track's own standard deviations (chi-square with 2
+  // degrees of freedom when the covariance is honest); none without a positive-definite one.
+  std::optional<double> nees() const;
 };
 
 struct VelocityGroup {
@@ -33,5 +37,15 @@ struct VelocityGroup {
 // stretches of the sequence (num_frames scans). Age, class and frame groups hold dynamic labels
 // only (as the velocity RMSE does); the motion groups hold both.
 std::vector<VelocityGroup> breakdownVelocityErrors(const std::vector<VelocityPair>& pairs, int num_frames);
+
+// Whether the tracks' velocity covariances tell the size of their errors: over the dynamic pairs
+// of tracks aged min_age..max_age scans with a covariance, the mean NEES (2 when honest) and the
+// share of errors inside the covariance's 95 % ellipse (NEES <= 5.991, chi-square with 2 degrees
+// of freedom: 0.95 when honest; lower, overconfident).
+struct VelocityCalibration {
+  int pairs = 0;
+  std::optional<double> nees_mean, within_95;
+};
+VelocityCalibration velocityCalibration(const std::vector<VelocityPair>& pairs, int min_age, int max_age);
 
 }  // namespace dlslot::eval

@@ -2,6 +2,7 @@
 
 #include "palette.hpp"  // procs/renderer: the same track colours as the bird's-eye images
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -51,6 +52,17 @@ std::string fixed(double v, int decimals) {
   char buf[48];
   std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
   return buf;
+}
+
+// The standard deviation of a track's speed: its velocity covariance along its velocity; 0 when
+// it gave none (a still track, or covariances not computed).
+double speedSigma(const track_t& t) {
+  const double speed = std::hypot(t.velocity[0], t.velocity[1], t.velocity[2]);
+  if (speed <= 0) return 0;
+  double var = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) var += t.velocity[i] * t.velocity_covariance[3 * i + j] * t.velocity[j];
+  return std::sqrt(std::max(0.0, var)) / speed;
 }
 
 }  // namespace
@@ -326,14 +338,17 @@ void Converter::add(const slot_state_t& m, std::vector<Output>& out) {
       const double* q = t.pose.orientation;  // w x y z: heading of the box's x axis
       b.yaw = std::atan2(2 * (q[0] * q[3] + q[1] * q[2]), 1 - 2 * (q[2] * q[2] + q[3] * q[3]));
       const double speed = std::hypot(t.velocity[0], t.velocity[1], t.velocity[2]);
+      const double sigma = speedSigma(t);
       idColour(t.id, c);
       const char* status = t.status == track_t::STATUS_CONFIRMED ? "confirmed"
                            : t.status == track_t::STATUS_COASTING ? "coasting" : "tentative";
       boxEntity(m.utime, kWorldFrame, "track/" + std::to_string(t.id), b, c,
-                std::to_string(t.id) + " " + t.type + " " + fixed(speed, 1) + " m/s" + (t.is_dynamic ? "" : " static"),
+                std::to_string(t.id) + " " + t.type + " " + fixed(speed, 1) + (sigma > 0 ? "±" + fixed(sigma, 1) : "") +
+                    " m/s" + (t.is_dynamic ? "" : " static"),
                 {{"id", std::to_string(t.id)},
                  {"class", t.type},
                  {"speed_mps", fixed(speed, 2)},
+                 {"speed_sigma_mps", fixed(sigma, 2)},
                  {"dynamic", t.is_dynamic ? "true" : "false"},
                  {"status", status},
                  {"confidence", fixed(t.confidence, 3)}},

@@ -137,7 +137,9 @@ TEST(BackendWindowSolver, SameMinimumAndCovarianceAsCeres) {
   ceres::Covariance covariance(co);
   const double* x_t = b.ego.back().data();
   const double* o_t = b.object.back().data();
-  ASSERT_TRUE(covariance.Compute({{x_t, x_t}, {b.landmark.data(), b.landmark.data()}, {o_t, o_t}}, &problem));
+  const double* o_prev = b.object[b.object.size() - 2].data();
+  ASSERT_TRUE(covariance.Compute(
+      {{x_t, x_t}, {b.landmark.data(), b.landmark.data()}, {o_t, o_t}, {o_prev, o_prev}, {o_prev, o_t}}, &problem));
   Matrix6 ego_ceres, landmark_ceres, object_ceres;
   covariance.GetCovarianceBlockInTangentSpace(x_t, x_t, ego_ceres.data());
   covariance.GetCovarianceBlockInTangentSpace(b.landmark.data(), b.landmark.data(), landmark_ceres.data());
@@ -155,4 +157,18 @@ TEST(BackendWindowSolver, SameMinimumAndCovarianceAsCeres) {
   ASSERT_TRUE(object_exact.has_value());
   EXPECT_LT((*object_exact - object_ceres).norm(), 1e-3 * object_ceres.norm()) << *object_exact << "\n\n" << object_ceres;
   EXPECT_FALSE(solver.covariance(a.ego.front().data()).has_value());  // not in the tail
+
+  // The joint covariance of two poses of the object (a velocity's, from their difference).
+  Eigen::MatrixXd joint_ceres(12, 12);
+  Matrix6 block;
+  covariance.GetCovarianceBlockInTangentSpace(o_prev, o_prev, block.data());
+  joint_ceres.topLeftCorner<6, 6>() = block.transpose();  // ceres writes row-major
+  covariance.GetCovarianceBlockInTangentSpace(o_prev, o_t, block.data());
+  joint_ceres.topRightCorner<6, 6>() = block.transpose();
+  joint_ceres.bottomLeftCorner<6, 6>() = block;
+  joint_ceres.bottomRightCorner<6, 6>() = object_ceres.transpose();
+  const auto joint = whole_tail.jointCovariance({a.object[a.object.size() - 2].data(), a.object.back().data()});
+  ASSERT_TRUE(joint.has_value());
+  EXPECT_LT((*joint - joint_ceres).norm(), 1e-3 * joint_ceres.norm()) << *joint << "\n\n" << joint_ceres;
+  EXPECT_FALSE(solver.jointCovariance({a.object.back().data(), a.ego.back().data()}).has_value());  // two groups
 }

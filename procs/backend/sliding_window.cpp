@@ -700,6 +700,7 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
     e.confidence = track.confidence;
     for (const auto& [f, obs] : track.observations) e.num_observations += obs.in_graph;
     const double* block = nullptr;
+    std::optional<Matrix6> block_covariance;  // when the velocity's joint covariance gave it
     if (!e.dynamic) {
       block = track.landmark->data();
       e.pose = fromBlock(block);
@@ -746,9 +747,11 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
           // Its covariance from the two poses' joint one; their tangents' translations are the
           // world's (pose_manifold.hpp), so the difference's is C_ll + C_ff - C_lf - C_fl.
           if (config_.compute_covariance)
-            if (const auto C = solver_.jointCovariance({first->second->data(), last->second->data()}))
+            if (const auto C = solver_.jointCovariance({first->second->data(), last->second->data()})) {
               track.velocity_covariance = (C->block<3, 3>(0, 0) + C->block<3, 3>(6, 6) - C->block<3, 3>(0, 6) -
                                            C->block<3, 3>(6, 0)) / (span * span);
+              if (last->second->data() == block) block_covariance = C->block<6, 6>(6, 6);
+            }
         }
       } else if (!track.velocity_from_chain) {
         // Young: the line through its boxes in the window (evidence before initialization
@@ -773,7 +776,7 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
     // track_front.hpp) is the other end is published turned by pi, the same box (velocity and
     // covariance are world-frame and unchanged).
     if (isVehicle(track.type) && turned(track.front)) e.pose.linear() = e.pose.linear() * Eigen::Vector3d(-1, -1, 1).asDiagonal();
-    if (block) e.covariance = covariance(block);
+    if (block) e.covariance = block_covariance ? *block_covariance : covariance(block);
     // The published box made to cover the object's accumulated points of this frame (a partly
     // seen car's size and centre); the graph keeps its own estimate. Only the points within the
     // fixed margin of its box: the wider margin of a far box's crop (attachObjectPoints) reached

@@ -143,6 +143,7 @@ void writeRun(const std::string& path, bool with_truth = true) {
       tr.pose = toMsg(objects[k].pose());
       for (int i = 0; i < 3; ++i) tr.size[i] = objects[k].size[i];
       tr.velocity[0] = k == 0 ? 15.0 : 0.0;
+      if (k == 0) tr.velocity_covariance[0] = tr.velocity_covariance[4] = tr.velocity_covariance[8] = 0.04;
       tr.is_dynamic = k == 0;
       tr.last_seen_frame = t;
       slot.tracks.push_back(tr);
@@ -280,6 +281,10 @@ TEST_F(EvalLog, ARecordedRunGivesTheKnownMetrics) {
   EXPECT_NEAR(*value(json, "tracking.hota"), 1.0, 1e-9);
   EXPECT_NEAR(*value(json, "tracking.velocity_rmse_mps"), 0.0, 1e-6);
   EXPECT_NEAR(*value(json, "tracking.velocity_young_rmse_mps"), *value(json, "velocity.age.0-4.rmse_mps"), 1e-12);
+  // The moving track's velocity covariance (sigma 0.2 m/s) holds its exact velocity.
+  EXPECT_NEAR(*value(json, "tracking.velocity_nees"), 0.0, 1e-6);
+  EXPECT_DOUBLE_EQ(*value(json, "tracking.velocity_within_95"), 1.0);
+  EXPECT_DOUBLE_EQ(*value(json, "tracking.velocity_young_within_95"), 1.0);
   // The backend's registrations by outcome, from its last status; its other counters are not these.
   EXPECT_EQ(*value(json, "registration.measured"), 7);
   EXPECT_EQ(*value(json, "registration.too_few_points"), 3);
@@ -301,6 +306,7 @@ TEST_F(EvalLog, ARecordedRunGivesTheKnownMetrics) {
   const std::string report = slurp(dir_ / "out" / "report.md");
   EXPECT_NE(report.find("| slot (primary)"), std::string::npos) << report;
   EXPECT_NE(report.find("process odometry: 30 frames"), std::string::npos) << report;
+  EXPECT_NE(report.find("Velocity covariances: 100.0 % of"), std::string::npos) << report;
   // The backend's test of the odometry, counted from SLOT_STATE and said on the summary line.
   EXPECT_EQ(*value(json, "ego.odometry_tested_frames"), kFrames - 1);
   EXPECT_EQ(*value(json, "ego.odometry_disagreement_frames"), 2);

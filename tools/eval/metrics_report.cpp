@@ -367,6 +367,14 @@ std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plo
              "sequence\n\n"
           << velocityTable(*m.tracking).render()
           << "\nAge, class and stretch rows: dynamic labels only, as the velocity RMSE; motion rows: both.\n\n";
+    const VelocityCalibration all = velocityCalibration(m.tracking->clear.velocities, 0, INT_MAX);
+    const VelocityCalibration young = velocityCalibration(m.tracking->clear.velocities, 0, 4);
+    if (all.pairs > 0)
+      out << "Velocity covariances: " << num(100 * *all.within_95, "%.1f") << " % of " << all.pairs
+          << " velocity errors of moving objects lie inside their track's 95 % ellipse (tracks younger than 5 "
+          << "scans: " << num(young.within_95 ? Opt(100 * *young.within_95) : std::nullopt, "%.1f") << " % of "
+          << young.pairs << "; 95 % if honest, less if overconfident); mean NEES " << num(all.nees_mean, "%.2f")
+          << " (2 if honest).\n\n";
   }
   if (!m.kitti.empty()) {
     out << "## Tracking, KITTI protocol (3-D IoU >= " << num(m.kitti.begin()->second.min_iou, "%g")

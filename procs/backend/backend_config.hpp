@@ -48,8 +48,9 @@ struct BackendConfig {
   std::vector<std::string> vehicle_types = {"Car", "Van", "Truck", "Tram", "Cyclist"};
   // The RMS acceleration of moving vehicles (m/s^2), sideways and along. A vehicle's chain starts
   // straight: the yaw rate of its first pose change is zero-mean with sigma this over its speed
-  // (vehicle_motion_factor.hpp). A registered velocity of t seconds ago may have changed by this x t
-  // (registered_velocity.hpp). 0: neither.
+  // (vehicle_motion_factor.hpp). A registered velocity of t seconds ago, and a coasting track's
+  // velocity last seen t seconds ago, may have changed by this x t (registered_velocity.hpp). 0: none
+  // of these.
   double vehicle_acceleration = 0.0;
   // A detector's heading is as good as its class lets it be: per class, the rz sigma of its
   // boxes when that is more than observation_sigma's (landmark_sigma's) rz.

@@ -767,6 +767,13 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
       if (track.velocity) {
         e.velocity = *track.velocity;
         e.velocity_covariance = track.velocity_covariance;
+        // A coasting vehicle's chain ends in the frame it was last seen in, and so does the velocity
+        // read from it; it may have changed since by vehicle_acceleration x the time (a young
+        // track's registered velocities count their age already, pointsVelocities).
+        const double unseen_s = secondsBetween(f_last, t);
+        if (track.velocity_from_chain && unseen_s > 0)
+          e.velocity_covariance.topLeftCorner<2, 2>() +=
+              std::pow(config_.vehicle_acceleration * unseen_s, 2) * Eigen::Matrix2d::Identity();
       }
       e.angular_velocity = track.angular_velocity;
       if (track.velocity) track.front = withMotion(track.front, track.velocity->head<2>(), e.pose.linear().col(0).head<2>());

@@ -358,8 +358,8 @@ OdometryResult LidarOdometry::process(const Frame& frame, bool detections_availa
     pose = reanchored ? s2s_pose : s2m.solution.T_ref_cur;
     if (reanchored) map_.clear();
     ++frames_since_check_;
-    // The first motion came from starts 1 m apart (first_motion_guesses_m), which along a
-    // highway can all miss: the next map registration, the first from a velocity, is checked.
+    // The first motion won a vote of inlier counts, which along a highway can go to a chance
+    // winner: the next map registration, the first from a velocity, is checked.
     if (!moving_) frames_since_check_ = std::max(0, cfg_.check_every_frames - 1);
     out.status = Status::Ok;
     if (fallbacks_ > 0) {  // registered again: said once, for the logs

@@ -58,14 +58,13 @@ void readScanToScan(ConfigSection s, ScanToScanConfig& c) {
   s.get("nearby_beams", c.nearby_beams);
   s.get("candidates", c.candidates);
   s.get("min_correspondences", c.min_correspondences);
-  s.get("first_motion_guesses_m", c.first_motion_guesses_m);
   s.get("max_forward_m", c.max_forward_m);
   s.get("hypothesis_spacing_m", c.hypothesis_spacing_m);
   s.finish();
-  if (c.candidates < 3 || c.first_motion_guesses_m.empty() || !(c.max_forward_m >= 0.0) || !(c.hypothesis_spacing_m > 0.0) ||
+  if (c.candidates < 3 || !(c.max_forward_m >= 0.0) || !(c.hypothesis_spacing_m > 0.0) ||
       c.max_forward_m / c.hypothesis_spacing_m > 1000.0)
     throw ConfigError(s.file() + ": " + s.path() +
-                      ": expected candidates >= 3, at least one distance in first_motion_guesses_m, max_forward_m >= 0 and 0 < hypothesis_spacing_m with at most "
+                      ": expected candidates >= 3, max_forward_m >= 0 and 0 < hypothesis_spacing_m with at most "
                       "1000 hypotheses up to max_forward_m");
 }
 

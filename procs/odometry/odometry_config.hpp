@@ -57,12 +57,9 @@ struct ScanToScanConfig {
   int nearby_beams = 2;               // second/third match points come from beams this close
   int candidates = 10;                // ...among this many nearest previous points
   int min_correspondences = 30;
-  // Forward distances (m) the second scan of a sequence is registered from (no velocity yet).
-  // Along a highway these starts 1 m apart can all miss (below): the third scan's velocity check
-  // (OdometryConfig::check_every_frames) catches that.
-  std::vector<double> first_motion_guesses_m = {0.0, 1.0, 2.0, 3.0};
-  // Forward motion hypotheses (m per scan) for a velocity check that found the prediction
-  // suspect (lidar_odometry.cpp): registration starts from 0, spacing, 2 spacing, ...
+  // Forward motion hypotheses (m per scan) for the second scan of a sequence (no velocity yet)
+  // and for a velocity check that found the prediction suspect (lidar_odometry.cpp):
+  // registration starts from 0, spacing, 2 spacing, ...
   // max_forward_m ahead and keeps the solution with the most inliers. The spacing is what one
   // registration reaches: along a highway its nearest-neighbour correspondences stick to the
   // rails and the road, so it moves only 0.1-0.15 m towards a motion 2 m away, but from 0.3 m

@@ -30,9 +30,7 @@ TEST(OdometryFirstMotion, AHighwayStartAtFullSpeedIsFound) {
   ConfigSection root = loadConfig(std::string(DLSLOT_SOURCE_DIR) + "/config/dlslot.yaml");
   ConfigSection section = root.section("odometry");
   OdometryConfig cfg = readOdometryConfig(section);
-  const LidarConfig lidar = LidarConfig::read(root.section("lidar"));
-  cfg.sweep = lidar.sweep;
-  cfg.vertical_angle_error_rad = lidar.vertical_angle_error_rad;
+  takeLidar(LidarConfig::read(root.section("lidar")), cfg);
   OfflineOptions opts;
   opts.root = dir.string();
   opts.sequence = "0000";

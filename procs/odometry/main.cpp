@@ -166,9 +166,7 @@ int run(int argc, char** argv) {
   ConfigSection root_cfg = loadPipelineConfig(node_opts.config, channels);
   ConfigSection section = root_cfg.section("odometry");
   OdometryConfig cfg = readOdometryConfig(section);
-  const LidarConfig lidar = LidarConfig::read(root_cfg.section("lidar"));
-  cfg.sweep = lidar.sweep;
-  cfg.vertical_angle_error_rad = lidar.vertical_angle_error_rad;
+  takeLidar(LidarConfig::read(root_cfg.section("lidar")), cfg);
   const double timeout_s = section.get<double>("detections_timeout_s");
   section.finish();
   if (!(timeout_s > 0)) throw ConfigError(node_opts.config + ": odometry.detections_timeout_s: expected > 0");

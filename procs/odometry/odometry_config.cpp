@@ -86,6 +86,11 @@ void readScanToMap(ConfigSection s, ScanToMapConfig& c) {
 
 }  // namespace
 
+void takeLidar(const LidarConfig& lidar, OdometryConfig& cfg) {
+  cfg.sweep = lidar.sweep;
+  cfg.vertical_angle_error_rad = lidar.vertical_angle_error_rad;
+}
+
 OdometryConfig readOdometryConfig(ConfigSection& s) {
   OdometryConfig c;
   std::string mode;

@@ -143,5 +143,7 @@ const char* modeName(bool remove_detected_objects);
 // Reads every key of the odometry section (sub-sections are finished here; the caller
 // reads its own node-only keys from `section` and then calls section.finish()).
 OdometryConfig readOdometryConfig(ConfigSection& section);
+// The odometry's settings that describe the sensor, from the pipeline's lidar section.
+void takeLidar(const LidarConfig& lidar, OdometryConfig& cfg);
 
 }  // namespace dlslot::odometry

@@ -432,9 +432,9 @@ TEST(EvalTracking, EveryClassIsScoredAllAroundOnItsOwn) {
   EXPECT_EQ(m.tracking_by_class.count("cyclist"), 0u);
 }
 
-TEST(EvalTracking, VelocityErrorsAreBrokenDownByAgeClassMotionAndStretch) {
-  // One car tracked from frame 0, a van from frame 10, a parked car; 20 frames. The car's track is
-  // 1 m/s off along x, the van's 2 m/s, the parked car's 0.5 m/s.
+TEST(EvalTracking, VelocityErrorsAreBrokenDownByAgeClassMotionRangeAndStretch) {
+  // One car tracked from frame 0 10 m away, a van from frame 10 22 m away, a parked car; 20
+  // frames. The car's track is 1 m/s off along x, the van's 2 m/s, the parked car's 0.5 m/s.
   std::vector<TrackingFrame> frames;
   for (int t = 0; t < 20; ++t) {
     TrackingFrame f;
@@ -472,6 +472,11 @@ TEST(EvalTracking, VelocityErrorsAreBrokenDownByAgeClassMotionAndStretch) {
   EXPECT_EQ(find("class", "car").pairs, 20);  // the parked car is not dynamic
   EXPECT_NEAR(*find("motion", "static").rmse_mps, 0.5, 1e-12);
   EXPECT_EQ(find("motion", "dynamic").pairs, 30);
+  EXPECT_EQ(find("range", "0-20").pairs, 20);  // the car; the parked car (32 m) is not dynamic
+  EXPECT_NEAR(*find("range", "0-20").rmse_mps, 1.0, 1e-12);
+  EXPECT_EQ(find("range", "20-40").pairs, 10);  // the van
+  EXPECT_NEAR(*find("range", "20-40").rmse_mps, 2.0, 1e-12);
+  for (const VelocityGroup& g : groups) EXPECT_FALSE(g.dimension == "range" && (g.bin == "40-60" || g.bin == "60+"));
   EXPECT_EQ(find("frames", "000-001").pairs, 2);
   EXPECT_NEAR(*find("frames", "018-019").rmse_mps, std::sqrt((2 * 1.0 + 2 * 4.0) / 4), 1e-12);
 }

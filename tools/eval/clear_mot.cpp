@@ -61,7 +61,7 @@ ClearMot evaluateClearMot(const std::vector<TrackingFrame>& frames, const MatchC
       if (g.velocity && h.velocity)
         m.velocities.push_back({static_cast<int>(index), g.box.id, h.box.id, g.box.type, g.dynamic,
                                 static_cast<int>(index) - first_output.at(h.box.id), *g.velocity, *h.velocity,
-                                h.velocity_covariance});
+                                h.velocity_covariance, g.box.center.head<2>().norm()});
       if (g.dynamic && g.velocity && h.velocity) {
         velocity_sq_sum += (*g.velocity - *h.velocity).squaredNorm();
         ++m.velocity_pairs;

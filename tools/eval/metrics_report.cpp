@@ -363,10 +363,11 @@ std::string reportMarkdown(const Metrics& m, const std::vector<std::string>& plo
         << num(m.tracking->criterion.max_distance_m, "%g") << " m) of the centre distance d for the distance line.\n\n"
         << "Velocities: " << m.velocity_frame << ".\n\n";
     if (!m.tracking->velocity_groups.empty())
-      out << "### Velocity error by track age (scans since first output), class, motion and stretch of the "
-             "sequence\n\n"
+      out << "### Velocity error by track age (scans since first output), class, motion, range (m, the "
+             "label's from the sensor) and stretch of the sequence\n\n"
           << velocityTable(*m.tracking).render()
-          << "\nAge, class and stretch rows: dynamic labels only, as the velocity RMSE; motion rows: both.\n\n";
+          << "\nAge, class, range and stretch rows: dynamic labels only, as the velocity RMSE; motion rows: "
+             "both.\n\n";
     const VelocityCalibration all = velocityCalibration(m.tracking->clear.velocities, 0, INT_MAX);
     const VelocityCalibration young = velocityCalibration(m.tracking->clear.velocities, 0, 4);
     if (all.pairs > 0)
@@ -446,7 +447,7 @@ void writeVelocityErrorsCsv(const std::string& path, const Metrics& m) {
   std::ostringstream out;
   // The track's covariance and NEES empty where it gave none.
   out << "frame_index,label_id,track_id,class,dynamic,track_age,truth_vx,truth_vy,track_vx,track_vy,error_mps,"
-         "track_cov_xx,track_cov_xy,track_cov_yy,nees\n";
+         "track_cov_xx,track_cov_xy,track_cov_yy,nees,range_m\n";
   if (m.tracking)
     for (const VelocityPair& p : m.tracking->clear.velocities) {
       char buf[256];
@@ -464,7 +465,8 @@ void writeVelocityErrorsCsv(const std::string& path, const Metrics& m) {
         std::snprintf(buf, sizeof buf, "%.4f", *nees);
         out << buf;
       }
-      out << "\n";
+      std::snprintf(buf, sizeof buf, ",%.2f\n", p.range_m);
+      out << buf;
     }
   writeText(path, out.str());
 }

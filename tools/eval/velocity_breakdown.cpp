@@ -18,6 +18,13 @@ std::string ageBin(int age) {
   return "20+";
 }
 
+std::string rangeBin(double range_m) {
+  if (range_m < 20) return "0-20";
+  if (range_m < 40) return "20-40";
+  if (range_m < 60) return "40-60";
+  return "60+";
+}
+
 std::string lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;
@@ -49,12 +56,13 @@ std::vector<VelocityGroup> breakdownVelocityErrors(const std::vector<VelocityPai
     return std::string(buf);
   };
   // Ordered bins per dimension; std::map keeps classes and frame stretches sorted.
-  std::map<std::string, std::vector<double>> age, cls, motion, frames;
+  std::map<std::string, std::vector<double>> age, cls, motion, range, frames;
   for (const VelocityPair& p : pairs) {
     motion[p.dynamic ? "dynamic" : "static"].push_back(p.error());
     if (!p.dynamic) continue;
     age[ageBin(p.track_age)].push_back(p.error());
     cls[lower(p.type)].push_back(p.error());
+    range[rangeBin(p.range_m)].push_back(p.error());
     frames[frameBin(p.frame_index)].push_back(p.error());
   }
   std::vector<VelocityGroup> out;
@@ -63,6 +71,8 @@ std::vector<VelocityGroup> breakdownVelocityErrors(const std::vector<VelocityPai
   for (auto& [bin, e] : cls) out.push_back(summarize("class", bin, std::move(e)));
   for (const char* bin : {"dynamic", "static"})
     if (motion.count(bin)) out.push_back(summarize("motion", bin, motion[bin]));
+  for (const char* bin : {"0-20", "20-40", "40-60", "60+"})
+    if (range.count(bin)) out.push_back(summarize("range", bin, range[bin]));
   for (auto& [bin, e] : frames) out.push_back(summarize("frames", bin, std::move(e)));
   return out;
 }

@@ -1,6 +1,6 @@
 // Where the velocity error comes from: the matched pairs' velocity errors grouped by the track's
-// age, the label's class, whether the label moves, and the part of the sequence (the evaluation asks
-// for this breakdown; a single RMSE hides whether young tracks or one bad stretch dominate it).
+// age, the label's class, whether the label moves, its range and the part of the sequence (a single
+// RMSE hides whether young tracks, far objects or one bad stretch dominate it).
 #pragma once
 
 #include <optional>
@@ -20,6 +20,7 @@ struct VelocityPair {
   int track_age = 0;     // scans since the track was first output (0 = its first scan)
   Eigen::Vector2d truth = Eigen::Vector2d::Zero(), track = Eigen::Vector2d::Zero();
   std::optional<Eigen::Matrix2d> track_covariance = std::nullopt;  // the track's own, when it gave one
+  double range_m = 0;    // the label's horizontal distance from the sensor
   double error() const { return (truth - track).norm(); }
   // e^T C^-1 e: the squared error in the track's own standard deviations (chi-square with 2
   // degrees of freedom when the covariance is honest); none without a positive-definite one.
@@ -27,15 +28,16 @@ struct VelocityPair {
 };
 
 struct VelocityGroup {
-  std::string dimension;  // "age", "class", "motion", "frames"
-  std::string bin;        // e.g. "0-4", "car", "dynamic", "000-029"
+  std::string dimension;  // "age", "class", "motion", "range", "frames"
+  std::string bin;        // e.g. "0-4", "car", "dynamic", "20-40", "000-029"
   int pairs = 0;
   std::optional<double> rmse_mps, mean_mps, p90_mps;
 };
 
-// Groups: track age 0-4 / 5-9 / 10-19 / 20+ scans, each class, dynamic / static, and ten equal
-// stretches of the sequence (num_frames scans). Age, class and frame groups hold dynamic labels
-// only (as the velocity RMSE does); the motion groups hold both.
+// Groups: track age 0-4 / 5-9 / 10-19 / 20+ scans, each class, dynamic / static, range 0-20 /
+// 20-40 / 40-60 / 60+ m (a detector's boxes and the points on an object both worsen with range),
+// and ten equal stretches of the sequence (num_frames scans). Age, class, range and frame groups
+// hold dynamic labels only (as the velocity RMSE does); the motion groups hold both.
 std::vector<VelocityGroup> breakdownVelocityErrors(const std::vector<VelocityPair>& pairs, int num_frames);
 
 // Whether the tracks' velocity covariances tell the size of their errors: over the dynamic pairs

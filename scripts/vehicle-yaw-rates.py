@@ -7,9 +7,11 @@ KITTI_DIR holds training/label_02, training/calib and the velodyne poses (poses/
 For every labelled Car, Van and Truck and every frame with labels 0.5 s before and after, the
 speed is the central difference of its world centres and the yaw rate that of its world heading
 (the box's, taken modulo pi: a label turned round is not a turn), both over +-0.5 s; the lateral
-acceleration is their product. Printed for vehicles faster than 2 m/s (slower, the poses' 0.1-
-0.15 m jitter is a large part of the motion): RMS and percentiles of |yaw rate| and |lateral
-acceleration|, and the RMS of the yaw rate in speed bands."""
+acceleration is their product, and the lateral jerk the change of that product from 0.5 s before
+to 0.5 s after, over 1 s. Printed for vehicles faster than 2 m/s (slower, the poses' 0.1-0.15 m
+jitter is a large part of the motion): RMS and percentiles of |yaw rate|, |lateral acceleration|
+and |lateral jerk|, and the RMS of the yaw rate in speed bands. The jerk differences the labels'
+headings twice: their noise is in it (an upper bound)."""
 import collections, math, os, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -31,6 +33,12 @@ def heading(to_world, ry):
     o = apply(to_world, [0.0, 0.0, 0.0])
     p = apply(to_world, [math.cos(ry), 0.0, -math.sin(ry)])
     return math.atan2(p[1] - o[1], p[0] - o[0])
+
+
+def lateral_acceleration_at(track, f):
+    """Yaw rate x speed at frame f, both central differences over +-HALF frames (signed)."""
+    rate = modulo_pi(track[f + HALF][2] - track[f - HALF][2]) / SPAN
+    return rate * speed_at(track, f)
 
 
 def modulo_pi(a):
@@ -56,7 +64,7 @@ def main():
     sequences = sys.argv[2:] or sequences_with_poses(root)
     if not sequences:
         sys.exit(f"{root}: no poses/SSSS.txt or training/poses/SSSS.txt")
-    rates, lateral, longitudinal = [], [], []
+    rates, lateral, longitudinal, jerk = [], [], [], []
     by_speed = collections.defaultdict(list)
     for seq in sequences:
         to_world = camera_to_world(root, seq)
@@ -80,6 +88,7 @@ def main():
                 rate = modulo_pi(track[f + HALF][2] - track[f - HALF][2]) / SPAN
                 if f - 2 * HALF in track and f + 2 * HALF in track:
                     longitudinal.append(abs(speed_at(track, f + HALF) - speed_at(track, f - HALF)) / SPAN)
+                    jerk.append(abs(lateral_acceleration_at(track, f + HALF) - lateral_acceleration_at(track, f - HALF)) / SPAN)
                 rates.append(abs(rate))
                 lateral.append(abs(rate) * speed)
                 by_speed[min(int(speed // 5) * 5, 20)].append(rate)
@@ -98,6 +107,10 @@ def main():
         print(f"longitudinal acceleration m/s^2 ({len(longitudinal)} frames): RMS {rms(longitudinal):.3f}, "
               f"median {percentile(longitudinal, 0.5):.3f}, p90 {percentile(longitudinal, 0.9):.3f}, "
               f"p99 {percentile(longitudinal, 0.99):.3f}")
+    if jerk:
+        jerk.sort()
+        print(f"lateral jerk m/s^3 ({len(jerk)} frames): RMS {rms(jerk):.3f}, median {percentile(jerk, 0.5):.3f}, "
+              f"p90 {percentile(jerk, 0.9):.3f}, p99 {percentile(jerk, 0.99):.3f}")
     for lo in sorted(by_speed):
         hi = "" if lo == 20 else f"-{lo + 5}"
         print(f"  speed {lo}{hi or '+'} m/s: {len(by_speed[lo])} frames, yaw rate RMS {rms(by_speed[lo]):.3f} rad/s")

@@ -703,4 +703,6 @@ TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
   expectRefused("switch_min_sigmas", "-1");
   EXPECT_EQ(c.vehicle_acceleration, 1.0);
   for (const char* bad : {"-1", "fast"}) expectRefused("vehicle_acceleration", bad);
+  EXPECT_EQ(c.vehicle_lateral_jerk, 1.0);
+  for (const char* bad : {"-0.5", "sharp"}) expectRefused("vehicle_lateral_jerk", bad);
 }

@@ -81,6 +81,8 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   s.get("vehicle_types", c.vehicle_types);
   s.get("vehicle_acceleration", c.vehicle_acceleration);
   require(c.vehicle_acceleration >= 0.0, s, "vehicle_acceleration", "an acceleration >= 0 (m/s^2)");
+  s.get("vehicle_lateral_jerk", c.vehicle_lateral_jerk);
+  require(c.vehicle_lateral_jerk >= 0.0, s, "vehicle_lateral_jerk", "a jerk >= 0 (m/s^3)");
   ConfigSection headings = s.section("heading_sigma_by_type");
   for (const std::string& type : headings.keys()) {
     const double sigma = headings.get<double>(type);

@@ -52,6 +52,11 @@ struct BackendConfig {
   // velocity last seen t seconds ago, may have changed by this x t (registered_velocity.hpp). 0: none
   // of these.
   double vehicle_acceleration = 0.0;
+  // How fast a vehicle's sideways acceleration may build (m/s^3). Eq. 11's yaw sigma for a vehicle
+  // is this x dt^2 over its speed: a turn's yaw rate is its sideways acceleration over its speed,
+  // so a car turning in at 5 m/s changes its yaw rate five times faster than one changing lanes at
+  // 25 m/s. 0: constant_velocity_sigma's rz for every class.
+  double vehicle_lateral_jerk = 0.0;
   // A detector's heading is as good as its class lets it be: per class, the rz sigma of its
   // boxes when that is more than observation_sigma's (landmark_sigma's) rz.
   std::map<std::string, double> heading_sigma_by_type;

@@ -566,7 +566,7 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
     }
     auto before = track.changes.find(f - 2);
     if (before != track.changes.end())
-      addFactor(ConstantVelocityFactor::Create(sqrtInformation(config_.constant_velocity_sigma)), false,
+      addFactor(ConstantVelocityFactor::Create(sqrtInformation(constantVelocitySigma(track, f, o_f, prev))), false,
                 {before->second->data(), change});
     auto before2 = track.changes.find(f - 3);
     if (before != track.changes.end() && before2 != track.changes.end())
@@ -578,11 +578,25 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
 void SlidingWindow::startStraight(const Track& track, int f, double* change, const Eigen::Vector3d& displacement) {
   const double dt = secondsBetween(f - 1, f);
   if (config_.vehicle_acceleration <= 0 || !(dt > 0)) return;
-  // Its speed: the track's velocity when it has one, else this first change's. Below 1 m/s a
-  // vehicle may turn on the spot as far as this prior is concerned.
-  const double speed = track.velocity ? track.velocity->head<2>().norm() : displacement.head<2>().norm() / dt;
-  const double sigma_rz = config_.vehicle_acceleration * dt / std::max(speed, 1.0);
+  const double sigma_rz = config_.vehicle_acceleration * dt / vehicleSpeed(track, displacement, dt);
   addFactor(VehicleMotionFactor::StartingStraight(sigma_rz), false, {change});
+}
+
+double SlidingWindow::vehicleSpeed(const Track& track, const Eigen::Vector3d& displacement, double dt) const {
+  // The track's velocity when it has one, else this frame's displacement. Below 1 m/s a vehicle
+  // may turn on the spot as far as the priors that divide by it are concerned.
+  const double speed = track.velocity ? track.velocity->head<2>().norm() : displacement.head<2>().norm() / dt;
+  return std::max(speed, 1.0);
+}
+
+Vector6 SlidingWindow::constantVelocitySigma(const Track& track, int f, const Pose& o_f, const double* prev) const {
+  Vector6 sigma = config_.constant_velocity_sigma;
+  const double dt = secondsBetween(f - 1, f);
+  if (config_.vehicle_lateral_jerk <= 0 || !isVehicle(track.type) || !(dt > 0)) return sigma;
+  // Eq. 11's rz is the change of the per-frame yaw, d(omega)/dt dt^2, and omega = a_lat / v.
+  const Eigen::Vector3d displacement = o_f.translation() - fromBlock(prev).translation();
+  sigma[5] = config_.vehicle_lateral_jerk * dt * dt / vehicleSpeed(track, displacement, dt);
+  return sigma;
 }
 
 // ---- step 3: a landmark that moves becomes a dynamic object ----

@@ -11,7 +11,7 @@ acceleration is their product, and the lateral jerk the change of that product f
 to 0.5 s after, over 1 s. Printed for vehicles faster than 2 m/s (slower, the poses' 0.1-0.15 m
 jitter is a large part of the motion): RMS and percentiles of |yaw rate|, |lateral acceleration|
 and |lateral jerk|, and the RMS of the yaw rate in speed bands. The jerk differences the labels'
-headings twice: their noise is in it (an upper bound)."""
+headings twice, so their noise is in it, and its 1 s spans smooth a sharp turn-in: a loose bound."""
 import collections, math, os, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -35,10 +35,13 @@ def heading(to_world, ry):
     return math.atan2(p[1] - o[1], p[0] - o[0])
 
 
+def yaw_rate_at(track, f):
+    """The signed yaw rate at frame f: the central difference of the headings HALF frames either side."""
+    return modulo_pi(track[f + HALF][2] - track[f - HALF][2]) / SPAN
+
+
 def lateral_acceleration_at(track, f):
-    """Yaw rate x speed at frame f, both central differences over +-HALF frames (signed)."""
-    rate = modulo_pi(track[f + HALF][2] - track[f - HALF][2]) / SPAN
-    return rate * speed_at(track, f)
+    return yaw_rate_at(track, f) * speed_at(track, f)
 
 
 def modulo_pi(a):
@@ -85,7 +88,7 @@ def main():
                 speed = speed_at(track, f)
                 if speed < 2.0:
                     continue
-                rate = modulo_pi(track[f + HALF][2] - track[f - HALF][2]) / SPAN
+                rate = yaw_rate_at(track, f)
                 if f - 2 * HALF in track and f + 2 * HALF in track:
                     longitudinal.append(abs(speed_at(track, f + HALF) - speed_at(track, f - HALF)) / SPAN)
                     jerk.append(abs(lateral_acceleration_at(track, f + HALF) - lateral_acceleration_at(track, f - HALF)) / SPAN)

@@ -537,10 +537,10 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
     double* prev = track.poses.at(f - 1)->data();
     double* cur = newBlock(track.poses[f], o_f);
     double* change = newBlock(track.changes[f - 1], fromBlock(prev).inverse() * o_f);  // eq. 2
+    const Eigen::Vector3d displacement = o_f.translation() - fromBlock(prev).translation();
     addFactor(PoseChangeFactor::Create(sqrtInformation(config_.pose_change_sigma)), false, {prev, cur, change});
     if (isVehicle(track.type)) addFactor(VehicleMotionFactor::Create(config_.vehicle_motion_sigma), false, {change});
-    if (isVehicle(track.type) && track.changes.size() == 1)
-      startStraight(track, f, change, o_f.translation() - fromBlock(prev).translation());
+    if (isVehicle(track.type) && track.changes.size() == 1) startStraight(track, f, change, displacement);
     // The object's points measured how it moved against the sensor between f - 1 and f (robust: a
     // wrong association registers two objects' points).
     const auto m = track.motions.find(f);
@@ -566,7 +566,7 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
     }
     auto before = track.changes.find(f - 2);
     if (before != track.changes.end())
-      addFactor(ConstantVelocityFactor::Create(sqrtInformation(constantVelocitySigma(track, f, o_f, prev))), false,
+      addFactor(ConstantVelocityFactor::Create(sqrtInformation(constantVelocitySigma(track, f, displacement))), false,
                 {before->second->data(), change});
     auto before2 = track.changes.find(f - 3);
     if (before != track.changes.end() && before2 != track.changes.end())
@@ -589,12 +589,11 @@ double SlidingWindow::vehicleSpeed(const Track& track, const Eigen::Vector3d& di
   return std::max(speed, 1.0);
 }
 
-Vector6 SlidingWindow::constantVelocitySigma(const Track& track, int f, const Pose& o_f, const double* prev) const {
+Vector6 SlidingWindow::constantVelocitySigma(const Track& track, int f, const Eigen::Vector3d& displacement) const {
   Vector6 sigma = config_.constant_velocity_sigma;
   const double dt = secondsBetween(f - 1, f);
   if (config_.vehicle_lateral_jerk <= 0 || !isVehicle(track.type) || !(dt > 0)) return sigma;
   // Eq. 11's rz is the change of the per-frame yaw, d(omega)/dt dt^2, and omega = a_lat / v.
-  const Eigen::Vector3d displacement = o_f.translation() - fromBlock(prev).translation();
   sigma[5] = config_.vehicle_lateral_jerk * dt * dt / vehicleSpeed(track, displacement, dt);
   return sigma;
 }

@@ -170,9 +170,9 @@ class SlidingWindow {
   void startStraight(const Track& track, int f, double* change, const Eigen::Vector3d& displacement);
   // A vehicle's speed for the priors above (m/s, at least 1).
   double vehicleSpeed(const Track& track, const Eigen::Vector3d& displacement, double dt) const;
-  // Eq. 11's sigmas for the pose change c_{f-1}^f that takes the track from `prev` to o_f: a
-  // vehicle's rz from vehicle_lateral_jerk at its speed, the rest constant_velocity_sigma.
-  Vector6 constantVelocitySigma(const Track& track, int f, const Pose& o_f, const double* prev) const;
+  // Eq. 11's sigmas for the pose change c_{f-1}^f, which moved the track by `displacement` (world):
+  // a vehicle's rz from vehicle_lateral_jerk at its speed, the rest constant_velocity_sigma.
+  Vector6 constantVelocitySigma(const Track& track, int f, const Eigen::Vector3d& displacement) const;
   int switchMovingLandmarks();
   void makeDynamic(Track& track);
   void solve(BackendOutput& out);

@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <vector>
 
 #include "sim/calib.hpp"
+#include "sim/detections.hpp"
 #include "sim/labels.hpp"
 #include "sim/simulation.hpp"
 
@@ -96,4 +99,87 @@ TEST(SimDetections, FoundByPointsNoisyAsConfiguredFalsePositivesScoredLower) {
   ASSERT_GT(fp, 3);
   EXPECT_NEAR(std::sqrt(err2 / tp), 1.0, 0.3);  // position errors have the configured sigma
   EXPECT_GT(tp_score / tp, fp_score / fp + 2.0);  // logits: true positives several units higher
+}
+
+TEST(SimDetections, DriftProcessHasUnitVarianceAndItsCorrelationTime) {
+  // Over many objects (keys): variance 1, correlation exp(-dt / time) at each lag, the two
+  // components independent, and the same key gives the same value.
+  const double time_s = 3.0;
+  for (const double dt : {0.1, 1.0, 3.0, 9.0}) {
+    double s00 = 0, s11 = 0, s01 = 0, cross = 0;
+    const int n = 4000;
+    for (int k = 0; k < n; ++k) {
+      const Eigen::Vector2d a = sim::driftProcess(sim::streamKey({42, static_cast<uint64_t>(k)}), 5.0, time_s);
+      const Eigen::Vector2d b = sim::driftProcess(sim::streamKey({42, static_cast<uint64_t>(k)}), 5.0 + dt, time_s);
+      s00 += a.x() * a.x();
+      s11 += b.x() * b.x();
+      s01 += a.x() * b.x();
+      cross += a.x() * a.y();
+    }
+    EXPECT_NEAR(s00 / n, 1.0, 0.1) << dt;
+    EXPECT_NEAR(s11 / n, 1.0, 0.1) << dt;
+    EXPECT_NEAR(s01 / std::sqrt(s00 * s11), std::exp(-dt / time_s), 0.06) << dt;
+    EXPECT_NEAR(cross / n, 0.0, 0.08) << dt;
+  }
+  EXPECT_EQ(sim::driftProcess(7, 1.5, time_s), sim::driftProcess(7, 1.5, time_s));
+}
+
+namespace {
+
+// Each detected car's centre error along and across its heading (lidar frame), per frame.
+std::map<int, std::vector<std::pair<int, Eigen::Vector2d>>> carErrors(const sim::Scenario& sc) {
+  sim::Simulation sim(sc);
+  std::map<int, std::vector<std::pair<int, Eigen::Vector2d>>> out;
+  for (int k = 0; k < sc.frames; ++k) {
+    const auto fd = sim.frame(k, 2);
+    std::map<int, const kitti::LabelRow*> by_id;
+    for (const auto& r : fd.detections)
+      if (r.track_id >= 0) by_id[r.track_id] = &r;
+    for (const auto& l : fd.labels) {
+      const auto it = by_id.find(l.track_id);
+      if (l.type != "Car" || it == by_id.end()) continue;
+      const Box truth = kitti::cameraToLidar(l.box, sim.calib());
+      const Box det = kitti::cameraToLidar(it->second->box, sim.calib());
+      const Eigen::Vector2d e = (det.center - truth.center).head<2>();
+      const Eigen::Vector2d along(std::cos(truth.yaw), std::sin(truth.yaw));
+      out[l.track_id].push_back({k, Eigen::Vector2d(e.dot(along), along.x() * e.y() - along.y() * e.x())});
+    }
+  }
+  return out;
+}
+
+// The along errors' correlation between consecutive frames of the same car, and the RMS along
+// and across.
+Eigen::Vector3d alongCorrelationAndRms(const std::map<int, std::vector<std::pair<int, Eigen::Vector2d>>>& errors) {
+  double s01 = 0, s00 = 0, s11 = 0, along2 = 0, across2 = 0;
+  int n = 0;
+  for (const auto& [id, v] : errors)
+    for (size_t i = 0; i < v.size(); ++i) {
+      along2 += v[i].second.x() * v[i].second.x();
+      across2 += v[i].second.y() * v[i].second.y();
+      ++n;
+      if (i == 0 || v[i - 1].first != v[i].first - 1) continue;
+      s01 += v[i - 1].second.x() * v[i].second.x();
+      s00 += v[i - 1].second.x() * v[i - 1].second.x();
+      s11 += v[i].second.x() * v[i].second.x();
+    }
+  return Eigen::Vector3d(s01 / std::sqrt(s00 * s11), std::sqrt(along2 / n), std::sqrt(across2 / n));
+}
+
+}  // namespace
+
+TEST(SimDetections, BoxesDriftAlongTheirHeadingWhenConfigured) {
+  sim::Scenario sc = sim::loadScenario(std::string(DLSLOT_SOURCE_DIR) + "/config/scenarios/highway.yaml");
+  sc.frames = 15;
+  const Eigen::Vector3d white = alongCorrelationAndRms(carErrors(sc));
+  EXPECT_LT(std::abs(white.x()), 0.3);  // the default: white noise, the same along and across
+  EXPECT_NEAR(white.y() / white.z(), 1.0, 0.25);
+  sc.detector.position_noise_m = 0.02;
+  sc.detector.position_noise_per_m = 0.0;
+  sc.detector.drift_m = 0.3;
+  sc.detector.drift_across_ratio = 0.2;
+  const Eigen::Vector3d drift = alongCorrelationAndRms(carErrors(sc));
+  EXPECT_GT(drift.x(), 0.9);                     // exp(-0.1 / 3) with a little white noise
+  EXPECT_NEAR(drift.y(), 0.3, 0.12);             // one drift process per car: few cars, loose
+  EXPECT_LT(drift.z(), 0.5 * drift.y());         // across: 0.2 of it
 }

@@ -16,10 +16,15 @@ double scoreLogit(const std::string& type, int points) {
   return -1.0 + 10.0 * (1.0 - std::exp(-points / scale));
 }
 
-Box noisy(const Box& truth, const DetectorSpec& spec, Rng& rng) {
+Box noisy(const DetectorTarget& target, const DetectorSpec& spec, Rng& rng) {
+  const Box& truth = target.box;
   Box b = truth;
-  const double sigma = spec.position_noise_m + spec.position_noise_per_m * truth.center.head<2>().norm();
+  const double range = truth.center.head<2>().norm();
+  const double sigma = spec.position_noise_m + spec.position_noise_per_m * range;
   b.center += Eigen::Vector3d(rng.normal(0, sigma), rng.normal(0, sigma), rng.normal(0, 0.5 * sigma));
+  const double drift = spec.drift_m + spec.drift_per_m * range;
+  const Eigen::Vector2d along(std::cos(truth.yaw), std::sin(truth.yaw)), across(-along.y(), along.x());
+  b.center.head<2>() += drift * (target.drift.x() * along + spec.drift_across_ratio * target.drift.y() * across);
   for (int i = 0; i < 3; ++i) b.size[i] *= std::max(0.5, 1.0 + rng.normal(0, spec.size_noise));
   const bool vehicle = isVehicle(truth.type);
   b.yaw += rng.normal(0, vehicle ? spec.yaw_noise : 0.3);  // pedestrians' headings are hard to see
@@ -54,6 +59,22 @@ kitti::LabelRow detectionRow(int frame, int track_id, const Box& box, double sco
 
 }  // namespace
 
+Eigen::Vector2d driftProcess(uint64_t key, double t_s, double time_s) {
+  // E[cos(w dt)] over a Cauchy w of scale 1/time is exp(-|dt| / time); each cosine of a random
+  // phase has variance 1/2, so sqrt(2 / kTerms) makes the sum's variance 1.
+  constexpr int kTerms = 32;
+  Eigen::Vector2d out = Eigen::Vector2d::Zero();
+  for (int c = 0; c < 2; ++c) {
+    Rng rng(streamKey({key, static_cast<uint64_t>(c)}));
+    for (int k = 0; k < kTerms; ++k) {
+      const double w = std::tan(M_PI * (rng.uniform() - 0.5)) / time_s;
+      const double phase = rng.uniform(0.0, 2.0 * M_PI);
+      out[c] += std::cos(w * t_s + phase);
+    }
+  }
+  return std::sqrt(2.0 / kTerms) * out;
+}
+
 std::vector<bool> chooseGhosts(const World& world, const DetectorSpec& spec, uint64_t key) {
   Rng rng(key);
   std::vector<bool> ghosts(world.structures.size(), false);
@@ -73,7 +94,7 @@ std::vector<kitti::LabelRow> detect(int frame, const std::vector<DetectorTarget>
   for (const DetectorTarget& t : targets) {
     const double p = spec.max_probability * (1.0 - std::exp(-M_LN2 * t.points / spec.points_for_half));
     if (!rng.chance(p)) continue;
-    const Box b = noisy(t.box, spec, rng);
+    const Box b = noisy(t, spec, rng);
     rows.push_back(
         detectionRow(frame, t.track_id, b, rng.normal(scoreLogit(t.box.type, t.points), 1.5), calib));
   }

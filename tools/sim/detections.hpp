@@ -19,7 +19,13 @@ struct DetectorTarget {
   Box box;            // lidar frame (type set)
   int track_id = -1;  // -1 when not (yet) labelled
   int points = 0;
+  Eigen::Vector2d drift = Eigen::Vector2d::Zero();  // driftProcess of this object now (along, across)
 };
+
+// Two independent unit-variance random processes of time (s), correlated by exp(-|dt| / time_s),
+// the same for the same key: a sum of cosines whose frequencies are drawn from that correlation's
+// spectrum (a Cauchy distribution of scale 1 / time_s), so any frame can be drawn alone.
+Eigen::Vector2d driftProcess(uint64_t key, double t_s, double time_s);
 
 // Which structures are persistent false-positive sources, chosen once per sequence.
 std::vector<bool> chooseGhosts(const World& world, const DetectorSpec& spec, uint64_t key);

@@ -67,7 +67,11 @@ Simulation::FrameData Simulation::frame(int index, int threads) {
     // DontCare rows keep the real 3D box so an evaluator can ignore matches there in bird's-eye view.
     fd.labels.push_back(
         labelRow(index, dontcare ? -1 : id, dontcare ? "DontCare" : box.type, box, calib_, occlusionLevel(view)));
-    targets.push_back({box, id, view.points});
+    Eigen::Vector2d drift = Eigen::Vector2d::Zero();
+    if (scenario_.detector.drift_m > 0 || scenario_.detector.drift_per_m > 0)
+      drift = driftProcess(streamKey({scenario_.seed, 8, static_cast<uint64_t>(agent_of[k])}), index * in.period_s,
+                           scenario_.detector.drift_time_s);
+    targets.push_back({box, id, view.points, drift});
   }
   Rng rng(streamKey({scenario_.seed, 7, static_cast<uint64_t>(index)}));
   fd.detections = detect(index, targets, fd.scan, world_, ghosts_, in.T_map_lidar, scenario_.detector, calib_, rng);

@@ -12,7 +12,9 @@ matched to the nearest labelled car, van or truck of the same frame within 2 m (
 Per 10 m of range: matches, the RMS error along and across the label's heading, and the RMS change
 of the along error between consecutive frames of the same label over sqrt 2. That last one equals
 the along RMS when the errors are white; when it is smaller, part of the error is a bias that
-stays from frame to frame (a partly seen car's box), which a velocity does not see. The backend's
+stays from frame to frame (a partly seen car's box), which a velocity does not see. Then, for
+labels within 40 m, the correlation of each error with the same label's 1, 2, 5, 10, 20 and 40
+frames later. The backend's
 box sigma at the bin's middle (observation_sigma x, y grown by observation_sigma_growth_per_m, read
 from config/dlslot.yaml) is printed beside them."""
 import collections, glob, math, os, re, sys
@@ -106,6 +108,23 @@ def main():
         change = f"{math.sqrt(d2 / nd / 2):13.3f}" if nd else f"{'':>13s}"
         print(f"{det:18s} {f'{lo}-{lo + 10}':>8s} {n:8d} {math.sqrt(a2 / n):7.3f} {math.sqrt(c2 / n):7.3f} {change}"
               f" {sx * g:8.3f} {sy * g:8.3f}")
+
+    lags = (1, 2, 5, 10, 20, 40)
+    print(f"\n{'detector':18s} {'within 40 m':12s} " + " ".join(f"{f'{k} fr':>6s}" for k in lags))
+    for det in sorted({key[0] for key in errors}):
+        for axis, name in ((0, "along"), (1, "across")):
+            row = []
+            for k in lags:
+                s01 = s00 = s11 = 0.0
+                for (d, seq, frame, label_id), e in errors.items():
+                    later = errors.get((d, seq, frame + k, label_id))
+                    if d != det or e[2] >= 40 or not later:
+                        continue
+                    s01 += e[axis] * later[axis]
+                    s00 += e[axis] ** 2
+                    s11 += later[axis] ** 2
+                row.append(f"{s01 / math.sqrt(s00 * s11):6.2f}" if s00 > 0 and s11 > 0 else f"{'':>6s}")
+            print(f"{det:18s} {name:12s} " + " ".join(row))
 
 
 if __name__ == "__main__":

@@ -9,7 +9,10 @@ separated rows: frame, type, 2-D box, score, h w l, x y z, rotation_y, alpha), e
 within 1 m. The heading error is taken modulo pi (a box and the box turned round are the same
 box; how often a detector turns one is its own column). Prints, per (detector, label class):
 matches, median, 90th percentile and RMS of the error in rad, and the share turned round."""
-import collections, glob, math, os, sys
+import collections, math, os, sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from kitti_frames import labels_and_detectors  # noqa: E402
 
 
 def wrap(a):
@@ -17,14 +20,7 @@ def wrap(a):
 
 
 def main():
-    if len(sys.argv) not in (2, 3):
-        sys.exit(__doc__)
-    root = sys.argv[1]
-    min_score = float(sys.argv[2]) if len(sys.argv) == 3 else 2.0
-    label_files = sorted(glob.glob(os.path.join(root, "training", "label_02", "*.txt")))
-    detectors = sorted(os.listdir(os.path.join(root, "detections")))
-    if not label_files or not detectors:
-        sys.exit(f"{root}: expected training/label_02/*.txt and detections/<name>/*.txt")
+    root, min_score, label_files, detectors = labels_and_detectors(sys.argv, __doc__)
     errors = collections.defaultdict(list)  # (detector, class) -> [(error mod pi, turned round)]
     for path in label_files:
         sequence = os.path.basename(path)

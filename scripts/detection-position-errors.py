@@ -12,12 +12,14 @@ matched to the nearest labelled car, van or truck of the same frame within 2 m (
 Per 10 m of range: matches, the RMS error along and across the label's heading, and the RMS change
 of the along error between consecutive frames of the same label over sqrt 2. That last one equals
 the along RMS when the errors are white; when it is smaller, part of the error is a bias that
-stays from frame to frame (a partly seen car's box), which a velocity does not see. Then, for
-labels within 40 m, the correlation of each error with the same label's 1, 2, 5, 10, 20 and 40
-frames later. The backend's
+stays from frame to frame (a partly seen car's box), which a velocity does not see. The backend's
 box sigma at the bin's middle (observation_sigma x, y grown by observation_sigma_growth_per_m, read
-from config/dlslot.yaml) is printed beside them."""
-import collections, glob, math, os, re, sys
+from config/dlslot.yaml) is printed beside them. Then, for labels within 40 m, the correlation of
+each error with the same label's 1, 2, 5, 10, 20 and 40 frames later."""
+import collections, math, os, re, sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from kitti_frames import labels_and_detectors  # noqa: E402
 
 VEHICLES = ("Car", "Van", "Truck")
 
@@ -55,14 +57,7 @@ def read_detections(path, min_score):
 
 
 def main():
-    if len(sys.argv) not in (2, 3):
-        sys.exit(__doc__)
-    root = sys.argv[1]
-    min_score = float(sys.argv[2]) if len(sys.argv) == 3 else 2.0
-    label_files = sorted(glob.glob(os.path.join(root, "training", "label_02", "*.txt")))
-    det_dirs = sorted(glob.glob(os.path.join(root, "detections", "*")))
-    if not label_files or not det_dirs:
-        sys.exit(f"{root}: expected training/label_02/*.txt and detections/<name>/*.txt")
+    root, min_score, label_files, detectors = labels_and_detectors(sys.argv, __doc__)
     sx, sy, growth = model_sigmas()
     errors = {}  # (detector, sequence, frame, label id) -> (along, across, range)
     for path in label_files:
@@ -72,8 +67,8 @@ def main():
             t = line.split()
             if t[2] in VEHICLES:
                 labels[int(t[0])].append((int(t[1]), float(t[13]), float(t[15]), float(t[16])))
-        for det_dir in det_dirs:
-            det_path = os.path.join(det_dir, sequence)
+        for detector in detectors:
+            det_path = os.path.join(root, "detections", detector, sequence)
             if not os.path.exists(det_path):
                 continue
             detections = read_detections(det_path, min_score)
@@ -87,7 +82,7 @@ def main():
                     # A label's forward direction in the camera's x-z plane.
                     ux, uz = math.cos(ry), -math.sin(ry)
                     ex, ez = dx - x, dz - z
-                    key = (os.path.basename(det_dir), sequence, frame, label_id)
+                    key = (detector, sequence, frame, label_id)
                     errors[key] = (ex * ux + ez * uz, -ex * uz + ez * ux, math.hypot(x, z))
     bins = collections.defaultdict(lambda: [0, 0.0, 0.0, 0, 0.0])
     for (det, seq, frame, label_id), (along, across, rng) in errors.items():

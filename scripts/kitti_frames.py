@@ -1,8 +1,10 @@
-"""KITTI tracking frames for the analysis scripts: 4x4 transforms as nested lists, and the
-transform from a sequence's rectified camera-0 coordinates (its labels) to the world of its
+"""KITTI tracking files and frames for the analysis scripts: the labels and detectors a folder
+holds, 4x4 transforms as nested lists, and the transform from a sequence's rectified camera-0 coordinates (its labels) to the world of its
 velodyne poses (ROOT/poses/SSSS.txt as in AB3DMOT's data, or ROOT/training/poses/SSSS.txt as the
 simulator writes them)."""
+import glob
 import os
+import sys
 
 
 def mat(v):
@@ -40,3 +42,19 @@ def camera_to_world(root, seq):
         return lambda f: cam_to_velo
     poses = [mat([float(x) for x in line.split()]) for line in open(path)]
     return lambda f: mul(poses[f], cam_to_velo)
+
+
+def labels_and_detectors(argv, usage):
+    """ROOT [MIN_SCORE] from argv -> (root, min_score (default 2), label files, detector names):
+    ROOT/training/label_02/SSSS.txt and ROOT/detections/<name>/SSSS.txt; exits with usage or
+    with what is missing."""
+    if len(argv) not in (2, 3):
+        sys.exit(usage)
+    root = argv[1]
+    min_score = float(argv[2]) if len(argv) == 3 else 2.0
+    label_files = sorted(glob.glob(os.path.join(root, "training", "label_02", "*.txt")))
+    det_root = os.path.join(root, "detections")
+    detectors = sorted(os.listdir(det_root)) if os.path.isdir(det_root) else []
+    if not label_files or not detectors:
+        sys.exit(f"{root}: expected training/label_02/*.txt and detections/<name>/*.txt")
+    return root, min_score, label_files, detectors

@@ -513,3 +513,43 @@ TEST(EvalVelocity, TheTracksCovarianceIsCheckedAgainstItsErrors) {
   EXPECT_NEAR(*young.within_95, 1.0, 1e-12);
   EXPECT_FALSE(velocityCalibration(m.velocities, 20, 100).nees_mean);
 }
+
+TEST(EvalVelocity, ErrorsByRangeBesideWhatTheTracksCovariancesPredict) {
+  // Dynamic pairs: at 5 m three mature ones 0.3 m/s off with covariance diag(0.04, 0.05) (own RMS
+  // 0.3); at 25 m two 1 m/s off with none, one 2 m/s off with diag(1, 3); a young pair at 5 m,
+  // a parked car's pair at 25 m and a lone pair at 45 m (under min_pairs) count nowhere.
+  std::vector<VelocityPair> pairs;
+  auto add = [&](double range, double error, int age, bool dynamic, std::optional<Eigen::Matrix2d> cov) {
+    VelocityPair p;
+    p.range_m = range;
+    p.track_age = age;
+    p.dynamic = dynamic;
+    p.truth = Eigen::Vector2d(10, 0);
+    p.track = Eigen::Vector2d(10, error);
+    p.track_covariance = cov;
+    pairs.push_back(p);
+  };
+  for (int k = 0; k < 3; ++k) add(5, 0.3, 20, true, Eigen::Matrix2d(Eigen::Vector2d(0.04, 0.05).asDiagonal()));
+  add(25, 1.0, 20, true, std::nullopt);
+  add(25, 1.0, 30, true, std::nullopt);
+  add(25, 2.0, 9, true, Eigen::Matrix2d(Eigen::Vector2d(1.0, 3.0).asDiagonal()));
+  add(5, 5.0, 2, true, std::nullopt);
+  add(25, 5.0, 20, false, std::nullopt);
+  add(45, 0.1, 20, true, std::nullopt);
+  const std::vector<VelocityRangeBin> bins = velocityErrorByRange(pairs, 10.0, 5, 1000, 2);
+  ASSERT_EQ(bins.size(), 2u);
+  EXPECT_DOUBLE_EQ(bins[0].range_from_m, 0.0);
+  EXPECT_DOUBLE_EQ(bins[0].range_to_m, 10.0);
+  EXPECT_EQ(bins[0].pairs, 3);
+  EXPECT_NEAR(bins[0].rmse_mps, 0.3, 1e-12);
+  EXPECT_NEAR(*bins[0].own_rms_mps, 0.3, 1e-12);
+  EXPECT_DOUBLE_EQ(bins[1].range_from_m, 20.0);
+  EXPECT_EQ(bins[1].pairs, 3);
+  EXPECT_NEAR(bins[1].rmse_mps, std::sqrt(6.0 / 3), 1e-12);
+  EXPECT_NEAR(*bins[1].own_rms_mps, 2.0, 1e-12);  // only the pair with a covariance
+  // The young pair alone, and no covariance to predict it.
+  const std::vector<VelocityRangeBin> young = velocityErrorByRange(pairs, 10.0, 0, 4, 1);
+  ASSERT_EQ(young.size(), 1u);
+  EXPECT_NEAR(young[0].rmse_mps, 5.0, 1e-12);
+  EXPECT_FALSE(young[0].own_rms_mps);
+}

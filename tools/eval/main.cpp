@@ -3,6 +3,7 @@
 // run's trajectories and tracks as files (KITTI / TUM formats).
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -543,6 +544,14 @@ int run(int argc, char** argv) {
         plotErrorOverDistance((out / "plots" / "error_over_distance.png").string(), sources, *truth);
         plots.push_back("plots/error_over_distance.png");
       }
+    }
+    if (metrics.tracking && metrics.tracking->clear.velocity_pairs > 0) {
+      // 10 m bins of at least 10 pairs: a bin's RMSE is then uncertain by a fifth of itself or less.
+      const std::vector<VelocityPair>& pairs = metrics.tracking->clear.velocities;
+      plotVelocityErrorByRange((out / "plots" / "velocity_error_by_range.png").string(),
+                               velocityErrorByRange(pairs, 10.0, 0, 4, 10),
+                               velocityErrorByRange(pairs, 10.0, 5, std::numeric_limits<int>::max(), 10));
+      plots.push_back("plots/velocity_error_by_range.png");
     }
     writeMetricsJson((out / "metrics.json").string(), metrics);
     writeVelocityErrorsCsv((out / "velocity_errors.csv").string(), metrics);

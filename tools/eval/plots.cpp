@@ -72,11 +72,26 @@ class Plot {
     cv::putText(image_, title, {(kWidth - size.width) / 2, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.6, ink, 1, cv::LINE_AA);
   }
 
-  void line(const Series& s, const cv::Scalar& colour, int thickness, const std::string& name) {
+  // A dot marks the first point (where a trajectory starts), or every point (sparse bins).
+  enum class Dots { First, Every };
+  void line(const Series& s, const cv::Scalar& colour, int thickness, const std::string& name, Dots dots = Dots::First,
+            bool dashed = false) {
     std::vector<cv::Point> px;
     for (const auto& p : s) px.push_back(toPixel(p));
-    cv::polylines(image_, px, false, colour, thickness, cv::LINE_AA);
-    if (!px.empty()) cv::circle(image_, px.front(), 4, colour, cv::FILLED, cv::LINE_AA);
+    if (!dashed) {
+      cv::polylines(image_, px, false, colour, thickness, cv::LINE_AA);
+    } else {
+      constexpr double kOn = 8, kPeriod = 14;  // pixels
+      for (size_t i = 1; i < px.size(); ++i) {
+        const cv::Point2d a = px[i - 1], d = cv::Point2d(px[i]) - a;
+        const double length = std::hypot(d.x, d.y);
+        for (double t = 0; t < length; t += kPeriod)
+          cv::line(image_, a + d * (t / length), a + d * (std::min(t + kOn, length) / length), colour, thickness,
+                   cv::LINE_AA);
+      }
+    }
+    for (size_t i = 0; i < px.size() && (i == 0 || dots == Dots::Every); ++i)
+      cv::circle(image_, px[i], 4, colour, cv::FILLED, cv::LINE_AA);
     legend_.emplace_back(name, colour);
   }
 
@@ -154,6 +169,28 @@ void plotErrorOverDistance(const std::string& path, const std::map<std::string, 
   plot.axes("distance along ground truth [m]", "position error after alignment [m]", "translation error over distance");
   size_t c = 0;
   for (const auto& [name, s] : series) plot.line(s, kColours[c++ % kColours.size()], 2, name);
+  plot.save(path);
+}
+
+void plotVelocityErrorByRange(const std::string& path, const std::vector<VelocityRangeBin>& young,
+                              const std::vector<VelocityRangeBin>& older) {
+  Eigen::Vector2d lo(0, 0), hi = lo;
+  const auto series = [&](const std::vector<VelocityRangeBin>& bins, bool own) {
+    Series s;
+    for (const VelocityRangeBin& b : bins)
+      if (!own || b.own_rms_mps) s.emplace_back(0.5 * (b.range_from_m + b.range_to_m), own ? *b.own_rms_mps : b.rmse_mps);
+    bounds(s, lo, hi);
+    return s;
+  };
+  const Series young_error = series(young, false), young_own = series(young, true);
+  const Series older_error = series(older, false), older_own = series(older, true);
+  hi.y() *= 1.25;  // room for the legend above the curves
+  Plot plot(lo, hi, false);
+  plot.axes("range of the object [m]", "velocity error, RMS [m/s]", "velocity error of moving objects by range");
+  plot.line(young_error, kColours[1], 2, "young (< 5 scans)", Plot::Dots::Every);
+  plot.line(young_own, kColours[1], 1, "own sigma (dashed)", Plot::Dots::Every, true);
+  plot.line(older_error, kColours[0], 2, "5+ scans", Plot::Dots::Every);
+  plot.line(older_own, kColours[0], 1, "own sigma (dashed)", Plot::Dots::Every, true);
   plot.save(path);
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "trajectory.hpp"
+#include "velocity_breakdown.hpp"
 
 namespace dlslot::eval {
 
@@ -18,5 +19,10 @@ void plotTrajectories(const std::string& path, const std::map<std::string, Traje
 // the ground truth.
 void plotErrorOverDistance(const std::string& path, const std::map<std::string, Trajectory>& sources,
                            const Trajectory& truth);
+
+// The velocity error of dynamic objects against their range, young tracks (< 5 scans) and older
+// ones apart, each beside the RMS error its tracks' own covariances predict (dashed).
+void plotVelocityErrorByRange(const std::string& path, const std::vector<VelocityRangeBin>& young,
+                              const std::vector<VelocityRangeBin>& older);
 
 }  // namespace dlslot::eval

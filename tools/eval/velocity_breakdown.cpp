@@ -104,4 +104,31 @@ VelocityCalibration velocityCalibration(const std::vector<VelocityPair>& pairs, 
   return c;
 }
 
+std::vector<VelocityRangeBin> velocityErrorByRange(const std::vector<VelocityPair>& pairs, double bin_m, int min_age,
+                                                   int max_age, int min_pairs) {
+  struct Sums {
+    int pairs = 0, with_covariance = 0;
+    double error_sq = 0, trace = 0;
+  };
+  std::map<int, Sums> bins;
+  for (const VelocityPair& p : pairs) {
+    if (!p.dynamic || p.track_age < min_age || p.track_age > max_age) continue;
+    Sums& s = bins[static_cast<int>(std::floor(p.range_m / bin_m))];
+    ++s.pairs;
+    s.error_sq += p.error() * p.error();
+    if (p.track_covariance) {
+      ++s.with_covariance;
+      s.trace += p.track_covariance->trace();
+    }
+  }
+  std::vector<VelocityRangeBin> out;
+  for (const auto& [index, s] : bins) {
+    if (s.pairs < min_pairs) continue;
+    VelocityRangeBin b{index * bin_m, (index + 1) * bin_m, s.pairs, std::sqrt(s.error_sq / s.pairs), std::nullopt};
+    if (s.with_covariance > 0) b.own_rms_mps = std::sqrt(s.trace / s.with_covariance);
+    out.push_back(b);
+  }
+  return out;
+}
+
 }  // namespace dlslot::eval

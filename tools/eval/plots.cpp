@@ -90,15 +90,23 @@ class Plot {
                    cv::LINE_AA);
       }
     }
+    // A dashed series' dots are rings, so a lone point still tells which series it is.
     for (size_t i = 0; i < px.size() && (i == 0 || dots == Dots::Every); ++i)
-      cv::circle(image_, px[i], 4, colour, cv::FILLED, cv::LINE_AA);
-    legend_.emplace_back(name, colour);
+      cv::circle(image_, px[i], dashed ? 5 : 4, colour, dashed ? 2 : cv::FILLED, cv::LINE_AA);
+    if (!px.empty()) legend_.push_back({name, colour, dashed});
   }
 
   void save(const std::string& path) {
     int y = kTop + 20;
-    for (const auto& [name, colour] : legend_) {
-      cv::line(image_, {kWidth - kRight - 170, y - 4}, {kWidth - kRight - 145, y - 4}, colour, 3, cv::LINE_AA);
+    for (const auto& [name, colour, dashed] : legend_) {
+      const int x0 = kWidth - kRight - 170, x1 = kWidth - kRight - 145;
+      if (dashed) {
+        cv::line(image_, {x0, y - 4}, {x0 + 8, y - 4}, colour, 1, cv::LINE_AA);
+        cv::line(image_, {x1 - 8, y - 4}, {x1, y - 4}, colour, 1, cv::LINE_AA);
+        cv::circle(image_, {(x0 + x1) / 2, y - 4}, 5, colour, 2, cv::LINE_AA);
+      } else {
+        cv::line(image_, {x0, y - 4}, {x1, y - 4}, colour, 3, cv::LINE_AA);
+      }
       cv::putText(image_, name, {kWidth - kRight - 138, y}, cv::FONT_HERSHEY_SIMPLEX, 0.45, colour, 1, cv::LINE_AA);
       y += 20;
     }
@@ -115,7 +123,12 @@ class Plot {
   static constexpr int kWidth = 1000, kHeight = 800, kLeft = 70, kRight = 20, kTop = 60, kBottom = 50;
   cv::Mat image_;
   Eigen::Vector2d lo_, hi_, scale_;
-  std::vector<std::pair<std::string, cv::Scalar>> legend_;
+  struct LegendEntry {
+    std::string name;
+    cv::Scalar colour;
+    bool dashed;
+  };
+  std::vector<LegendEntry> legend_;
 };
 
 Series bev(const Trajectory& t) {
@@ -177,8 +190,10 @@ void plotVelocityErrorByRange(const std::string& path, const std::vector<Velocit
   Eigen::Vector2d lo(0, 0), hi = lo;
   const auto series = [&](const std::vector<VelocityRangeBin>& bins, bool own) {
     Series s;
-    for (const VelocityRangeBin& b : bins)
+    for (const VelocityRangeBin& b : bins) {
+      hi.x() = std::max(hi.x(), b.range_to_m);  // the axis spans whole bins, from the sensor on
       if (!own || b.own_rms_mps) s.emplace_back(0.5 * (b.range_from_m + b.range_to_m), own ? *b.own_rms_mps : b.rmse_mps);
+    }
     bounds(s, lo, hi);
     return s;
   };
@@ -188,9 +203,9 @@ void plotVelocityErrorByRange(const std::string& path, const std::vector<Velocit
   Plot plot(lo, hi, false);
   plot.axes("range of the object [m]", "velocity error, RMS [m/s]", "velocity error of moving objects by range");
   plot.line(young_error, kColours[1], 2, "young (< 5 scans)", Plot::Dots::Every);
-  plot.line(young_own, kColours[1], 1, "own sigma (dashed)", Plot::Dots::Every, true);
+  plot.line(young_own, kColours[1], 1, "its own sigma", Plot::Dots::Every, true);
   plot.line(older_error, kColours[0], 2, "5+ scans", Plot::Dots::Every);
-  plot.line(older_own, kColours[0], 1, "own sigma (dashed)", Plot::Dots::Every, true);
+  plot.line(older_own, kColours[0], 1, "its own sigma", Plot::Dots::Every, true);
   plot.save(path);
 }
 

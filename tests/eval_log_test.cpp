@@ -304,6 +304,7 @@ TEST_F(EvalLog, ARecordedRunGivesTheKnownMetrics) {
   EXPECT_TRUE(fs::exists(dir_ / "out" / "plots" / "trajectories.png"));
   EXPECT_TRUE(fs::exists(dir_ / "out" / "plots" / "error_over_distance.png"));
   EXPECT_TRUE(fs::exists(dir_ / "out" / "plots" / "velocity_error_by_range.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "plots" / "velocity_error_by_age.png"));
   const std::string report = slurp(dir_ / "out" / "report.md");
   EXPECT_NE(report.find("| slot (primary)"), std::string::npos) << report;
   EXPECT_NE(report.find("process odometry: 30 frames"), std::string::npos) << report;

@@ -536,20 +536,30 @@ TEST(EvalVelocity, ErrorsByRangeBesideWhatTheTracksCovariancesPredict) {
   add(5, 5.0, 2, true, std::nullopt);
   add(25, 5.0, 20, false, std::nullopt);
   add(45, 0.1, 20, true, std::nullopt);
-  const std::vector<VelocityRangeBin> bins = velocityErrorByRange(pairs, 10.0, 5, 1000, 2);
+  const std::vector<VelocityBin> bins = velocityErrorByRange(pairs, 10.0, 5, 1000, 2);
   ASSERT_EQ(bins.size(), 2u);
-  EXPECT_DOUBLE_EQ(bins[0].range_from_m, 0.0);
-  EXPECT_DOUBLE_EQ(bins[0].range_to_m, 10.0);
+  EXPECT_DOUBLE_EQ(bins[0].from, 0.0);
+  EXPECT_DOUBLE_EQ(bins[0].to, 10.0);
   EXPECT_EQ(bins[0].pairs, 3);
   EXPECT_NEAR(bins[0].rmse_mps, 0.3, 1e-12);
   EXPECT_NEAR(*bins[0].own_rms_mps, 0.3, 1e-12);
-  EXPECT_DOUBLE_EQ(bins[1].range_from_m, 20.0);
+  EXPECT_DOUBLE_EQ(bins[1].from, 20.0);
   EXPECT_EQ(bins[1].pairs, 3);
   EXPECT_NEAR(bins[1].rmse_mps, std::sqrt(6.0 / 3), 1e-12);
   EXPECT_NEAR(*bins[1].own_rms_mps, 2.0, 1e-12);  // only the pair with a covariance
   // The young pair alone, and no covariance to predict it.
-  const std::vector<VelocityRangeBin> young = velocityErrorByRange(pairs, 10.0, 0, 4, 1);
+  const std::vector<VelocityBin> young = velocityErrorByRange(pairs, 10.0, 0, 4, 1);
   ASSERT_EQ(young.size(), 1u);
   EXPECT_NEAR(young[0].rmse_mps, 5.0, 1e-12);
   EXPECT_FALSE(young[0].own_rms_mps);
+  // By age with the last bin at 10: age 2 (the young pair), 9, and 10 holding ages 20 and 30.
+  const std::vector<VelocityBin> ages = velocityErrorByAge(pairs, 10, 1);
+  ASSERT_EQ(ages.size(), 3u);
+  EXPECT_DOUBLE_EQ(ages[0].from, 2.0);
+  EXPECT_DOUBLE_EQ(ages[1].from, 9.0);
+  EXPECT_NEAR(ages[1].rmse_mps, 2.0, 1e-12);
+  EXPECT_DOUBLE_EQ(ages[2].from, 10.0);
+  EXPECT_EQ(ages[2].pairs, 6);  // three at 5 m, two at 25 m, one at 45 m; the parked car's never
+  EXPECT_NEAR(ages[2].rmse_mps, std::sqrt((3 * 0.09 + 2 * 1.0 + 0.01) / 6), 1e-12);
+  EXPECT_NEAR(*ages[2].own_rms_mps, 0.3, 1e-12);
 }

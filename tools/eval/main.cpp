@@ -546,12 +546,14 @@ int run(int argc, char** argv) {
       }
     }
     if (metrics.tracking && metrics.tracking->clear.velocity_pairs > 0) {
-      // 10 m bins of at least 10 pairs: a bin's RMSE is then uncertain by a fifth of itself or less.
+      // Bins of at least 10 pairs: a bin's RMSE is then uncertain by about a fifth of itself.
       const std::vector<VelocityPair>& pairs = metrics.tracking->clear.velocities;
       plotVelocityErrorByRange((out / "plots" / "velocity_error_by_range.png").string(),
                                velocityErrorByRange(pairs, 10.0, 0, 4, 10),
                                velocityErrorByRange(pairs, 10.0, 5, std::numeric_limits<int>::max(), 10));
       plots.push_back("plots/velocity_error_by_range.png");
+      plotVelocityErrorByAge((out / "plots" / "velocity_error_by_age.png").string(), velocityErrorByAge(pairs, 20, 10));
+      plots.push_back("plots/velocity_error_by_age.png");
     }
     writeMetricsJson((out / "metrics.json").string(), metrics);
     writeVelocityErrorsCsv((out / "velocity_errors.csv").string(), metrics);

@@ -65,9 +65,11 @@ class Plot {
       }
     }
     cv::rectangle(image_, {kLeft, kTop}, {kWidth - kRight, kHeight - kBottom}, ink, 1);
-    cv::putText(image_, x_label, {kWidth / 2 - 40, kHeight - 12}, cv::FONT_HERSHEY_SIMPLEX, 0.5, ink, 1, cv::LINE_AA);
-    cv::putText(image_, y_label, {8, kTop - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.5, ink, 1, cv::LINE_AA);
     int baseline = 0;
+    const int x_label_width = cv::getTextSize(x_label, cv::FONT_HERSHEY_SIMPLEX, 0.5, 1, &baseline).width;
+    cv::putText(image_, x_label, {(kWidth - x_label_width) / 2, kHeight - 12}, cv::FONT_HERSHEY_SIMPLEX, 0.5, ink, 1,
+                cv::LINE_AA);
+    cv::putText(image_, y_label, {8, kTop - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.5, ink, 1, cv::LINE_AA);
     const cv::Size size = cv::getTextSize(title, cv::FONT_HERSHEY_SIMPLEX, 0.6, 1, &baseline);
     cv::putText(image_, title, {(kWidth - size.width) / 2, 22}, cv::FONT_HERSHEY_SIMPLEX, 0.6, ink, 1, cv::LINE_AA);
   }
@@ -185,20 +187,28 @@ void plotErrorOverDistance(const std::string& path, const std::map<std::string, 
   plot.save(path);
 }
 
-void plotVelocityErrorByRange(const std::string& path, const std::vector<VelocityRangeBin>& young,
-                              const std::vector<VelocityRangeBin>& older) {
+namespace {
+
+// Each bin's error (own = false) or its tracks' own sigma at x_of(bin); bins without a covariance
+// have no sigma point.
+Series binSeries(const std::vector<VelocityBin>& bins, bool own, double (*x_of)(const VelocityBin&)) {
+  Series s;
+  for (const VelocityBin& b : bins)
+    if (!own || b.own_rms_mps) s.emplace_back(x_of(b), own ? *b.own_rms_mps : b.rmse_mps);
+  return s;
+}
+
+}  // namespace
+
+void plotVelocityErrorByRange(const std::string& path, const std::vector<VelocityBin>& young,
+                              const std::vector<VelocityBin>& older) {
+  const auto centre = [](const VelocityBin& b) { return 0.5 * (b.from + b.to); };
+  const Series young_error = binSeries(young, false, centre), young_own = binSeries(young, true, centre);
+  const Series older_error = binSeries(older, false, centre), older_own = binSeries(older, true, centre);
   Eigen::Vector2d lo(0, 0), hi = lo;
-  const auto series = [&](const std::vector<VelocityRangeBin>& bins, bool own) {
-    Series s;
-    for (const VelocityRangeBin& b : bins) {
-      hi.x() = std::max(hi.x(), b.range_to_m);  // the axis spans whole bins, from the sensor on
-      if (!own || b.own_rms_mps) s.emplace_back(0.5 * (b.range_from_m + b.range_to_m), own ? *b.own_rms_mps : b.rmse_mps);
-    }
-    bounds(s, lo, hi);
-    return s;
-  };
-  const Series young_error = series(young, false), young_own = series(young, true);
-  const Series older_error = series(older, false), older_own = series(older, true);
+  for (const auto* bins : {&young, &older})
+    for (const VelocityBin& b : *bins) hi.x() = std::max(hi.x(), b.to);  // whole bins, from the sensor on
+  for (const Series* s : {&young_error, &young_own, &older_error, &older_own}) bounds(*s, lo, hi);
   hi.y() *= 1.25;  // room for the legend above the curves
   Plot plot(lo, hi, false);
   plot.axes("range of the object [m]", "velocity error, RMS [m/s]", "velocity error of moving objects by range");
@@ -206,6 +216,22 @@ void plotVelocityErrorByRange(const std::string& path, const std::vector<Velocit
   plot.line(young_own, kColours[1], 1, "its own sigma", Plot::Dots::Every, true);
   plot.line(older_error, kColours[0], 2, "5+ scans", Plot::Dots::Every);
   plot.line(older_own, kColours[0], 1, "its own sigma", Plot::Dots::Every, true);
+  plot.save(path);
+}
+
+void plotVelocityErrorByAge(const std::string& path, const std::vector<VelocityBin>& bins) {
+  const auto age = [](const VelocityBin& b) { return b.from; };
+  const Series error = binSeries(bins, false, age), own = binSeries(bins, true, age);
+  Eigen::Vector2d lo(0, 0), hi = lo;
+  bounds(error, lo, hi);
+  bounds(own, lo, hi);
+  hi.y() *= 1.15;
+  Plot plot(lo, hi, false);
+  const std::string last = bins.empty() ? "" : " (" + std::to_string(static_cast<int>(bins.back().from)) + ": that and older)";
+  plot.axes("track age [scans since its first output]" + last, "velocity error, RMS [m/s]",
+            "velocity error of moving objects by track age");
+  plot.line(error, kColours[0], 2, "error", Plot::Dots::Every);
+  plot.line(own, kColours[0], 1, "its own sigma", Plot::Dots::Every, true);
   plot.save(path);
 }
 

@@ -22,7 +22,10 @@ void plotErrorOverDistance(const std::string& path, const std::map<std::string, 
 
 // The velocity error of dynamic objects against their range, young tracks (< 5 scans) and older
 // ones apart, each beside the RMS error its tracks' own covariances predict (dashed).
-void plotVelocityErrorByRange(const std::string& path, const std::vector<VelocityRangeBin>& young,
-                              const std::vector<VelocityRangeBin>& older);
+void plotVelocityErrorByRange(const std::string& path, const std::vector<VelocityBin>& young,
+                              const std::vector<VelocityBin>& older);
+
+// The same against the track's age: how soon a new track's velocity can be trusted.
+void plotVelocityErrorByAge(const std::string& path, const std::vector<VelocityBin>& bins);
 
 }  // namespace dlslot::eval

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 
 #include <Eigen/Cholesky>
@@ -104,16 +105,20 @@ VelocityCalibration velocityCalibration(const std::vector<VelocityPair>& pairs, 
   return c;
 }
 
-std::vector<VelocityRangeBin> velocityErrorByRange(const std::vector<VelocityPair>& pairs, double bin_m, int min_age,
-                                                   int max_age, int min_pairs) {
+namespace {
+
+// Dynamic pairs binned by bin_of (none: the pair counts nowhere); bin k holds [k, k + 1) x width.
+std::vector<VelocityBin> velocityErrorBins(const std::vector<VelocityPair>& pairs, double width, int min_pairs,
+                                           const std::function<std::optional<int>(const VelocityPair&)>& bin_of) {
   struct Sums {
     int pairs = 0, with_covariance = 0;
     double error_sq = 0, trace = 0;
   };
   std::map<int, Sums> bins;
   for (const VelocityPair& p : pairs) {
-    if (!p.dynamic || p.track_age < min_age || p.track_age > max_age) continue;
-    Sums& s = bins[static_cast<int>(std::floor(p.range_m / bin_m))];
+    const std::optional<int> bin = p.dynamic ? bin_of(p) : std::nullopt;
+    if (!bin) continue;
+    Sums& s = bins[*bin];
     ++s.pairs;
     s.error_sq += p.error() * p.error();
     if (p.track_covariance) {
@@ -121,14 +126,30 @@ std::vector<VelocityRangeBin> velocityErrorByRange(const std::vector<VelocityPai
       s.trace += p.track_covariance->trace();
     }
   }
-  std::vector<VelocityRangeBin> out;
+  std::vector<VelocityBin> out;
   for (const auto& [index, s] : bins) {
     if (s.pairs < min_pairs) continue;
-    VelocityRangeBin b{index * bin_m, (index + 1) * bin_m, s.pairs, std::sqrt(s.error_sq / s.pairs), std::nullopt};
+    VelocityBin b{index * width, (index + 1) * width, s.pairs, std::sqrt(s.error_sq / s.pairs), std::nullopt};
     if (s.with_covariance > 0) b.own_rms_mps = std::sqrt(s.trace / s.with_covariance);
     out.push_back(b);
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<VelocityBin> velocityErrorByRange(const std::vector<VelocityPair>& pairs, double bin_m, int min_age,
+                                              int max_age, int min_pairs) {
+  return velocityErrorBins(pairs, bin_m, min_pairs, [&](const VelocityPair& p) -> std::optional<int> {
+    if (p.track_age < min_age || p.track_age > max_age) return std::nullopt;
+    return static_cast<int>(std::floor(p.range_m / bin_m));
+  });
+}
+
+std::vector<VelocityBin> velocityErrorByAge(const std::vector<VelocityPair>& pairs, int last_age, int min_pairs) {
+  return velocityErrorBins(pairs, 1.0, min_pairs, [&](const VelocityPair& p) -> std::optional<int> {
+    return std::min(p.track_age, last_age);
+  });
 }
 
 }  // namespace dlslot::eval

@@ -50,18 +50,20 @@ struct VelocityCalibration {
 };
 VelocityCalibration velocityCalibration(const std::vector<VelocityPair>& pairs, int min_age, int max_age);
 
-// The velocity error against range, for the plot: the dynamic pairs of tracks aged
-// min_age..max_age scans in bins of bin_m metres of the label's range. Each bin's RMSE beside the
-// RMS error the tracks' own covariances predict (sqrt of the mean trace over the pairs with one):
-// where the two part, the published covariance misjudges that range. Bins with fewer than
-// min_pairs pairs are left out (an RMSE of n errors is uncertain by about 1 / sqrt(2n) of itself).
-struct VelocityRangeBin {
-  double range_from_m = 0, range_to_m = 0;
+// The velocity error in bins, for the plots: each bin's RMSE over its dynamic pairs beside the RMS
+// error the tracks' own covariances predict (sqrt of the mean trace over the pairs with one): where
+// the two part, the published covariance misjudges those tracks. Bins with fewer than min_pairs
+// pairs are left out (an RMSE of n errors is uncertain by about 1 / sqrt(2n) of itself).
+struct VelocityBin {
+  double from = 0, to = 0;  // what the bin holds: range in m, or track age in scans
   int pairs = 0;
   double rmse_mps = 0;
   std::optional<double> own_rms_mps;  // none when no pair of the bin has a covariance
 };
-std::vector<VelocityRangeBin> velocityErrorByRange(const std::vector<VelocityPair>& pairs, double bin_m, int min_age,
-                                                   int max_age, int min_pairs);
+// By the label's range, bins of bin_m metres, over tracks aged min_age..max_age scans.
+std::vector<VelocityBin> velocityErrorByRange(const std::vector<VelocityPair>& pairs, double bin_m, int min_age,
+                                              int max_age, int min_pairs);
+// By the track's age, one bin a scan up to last_age, which holds every older track too.
+std::vector<VelocityBin> velocityErrorByAge(const std::vector<VelocityPair>& pairs, int last_age, int min_pairs);
 
 }  // namespace dlslot::eval

@@ -665,7 +665,7 @@ int runPipeline(int argc, char** argv) {
   std::cout << "to look at it: report.md has every table; " << (no_render ? "" : "bev/ one bird's-eye image a frame "
             "(points, boxes coloured by track with id and speed, the trajectories; any image viewer), ")
             << (no_map ? "" : "map.png the static map from above, map.pcd in any point-cloud viewer, ")
-            << "plots/ the trajectories and their errors\n";
+            << "plots/ the trajectories and their errors, the objects' velocity errors by range and by track age\n";
   std::cout << std::flush;
   std::cerr << "dlslot-run: " << accounting.verdict() << "\n";
   if (accounting.hasLoss() && !allow_loss) return 4;

@@ -102,23 +102,26 @@ TEST(SimDetections, FoundByPointsNoisyAsConfiguredFalsePositivesScoredLower) {
 }
 
 TEST(SimDetections, DriftProcessHasUnitVarianceAndItsCorrelationTime) {
-  // Over many objects (keys): variance 1, correlation exp(-dt / time) at each lag, the two
-  // components independent, and the same key gives the same value.
-  const double time_s = 3.0;
+  // Over many objects (keys): variance 1, each component correlated by exp(-dt / its time) at each
+  // lag (3 s along, 1 s across), the two independent, and the same key gives the same value.
+  const Eigen::Vector2d time_s(3.0, 1.0);
   for (const double dt : {0.1, 1.0, 3.0, 9.0}) {
-    double s00 = 0, s11 = 0, s01 = 0, cross = 0;
+    Eigen::Vector2d s00 = Eigen::Vector2d::Zero(), s11 = s00, s01 = s00;
+    double cross = 0;
     const int n = 4000;
     for (int k = 0; k < n; ++k) {
       const Eigen::Vector2d a = sim::driftProcess(sim::streamKey({42, static_cast<uint64_t>(k)}), 5.0, time_s);
       const Eigen::Vector2d b = sim::driftProcess(sim::streamKey({42, static_cast<uint64_t>(k)}), 5.0 + dt, time_s);
-      s00 += a.x() * a.x();
-      s11 += b.x() * b.x();
-      s01 += a.x() * b.x();
+      s00 += a.cwiseProduct(a);
+      s11 += b.cwiseProduct(b);
+      s01 += a.cwiseProduct(b);
       cross += a.x() * a.y();
     }
-    EXPECT_NEAR(s00 / n, 1.0, 0.1) << dt;
-    EXPECT_NEAR(s11 / n, 1.0, 0.1) << dt;
-    EXPECT_NEAR(s01 / std::sqrt(s00 * s11), std::exp(-dt / time_s), 0.06) << dt;
+    for (int c = 0; c < 2; ++c) {
+      EXPECT_NEAR(s00[c] / n, 1.0, 0.1) << dt << " " << c;
+      EXPECT_NEAR(s11[c] / n, 1.0, 0.1) << dt << " " << c;
+      EXPECT_NEAR(s01[c] / std::sqrt(s00[c] * s11[c]), std::exp(-dt / time_s[c]), 0.06) << dt << " " << c;
+    }
     EXPECT_NEAR(cross / n, 0.0, 0.08) << dt;
   }
   EXPECT_EQ(sim::driftProcess(7, 1.5, time_s), sim::driftProcess(7, 1.5, time_s));
@@ -182,4 +185,15 @@ TEST(SimDetections, BoxesDriftAlongTheirHeadingWhenConfigured) {
   EXPECT_GT(drift.x(), 0.9);                     // exp(-0.1 / 3) with a little white noise
   EXPECT_NEAR(drift.y(), 0.3, 0.12);             // one drift process per car: few cars, loose
   EXPECT_LT(drift.z(), 0.5 * drift.y());         // across: 0.2 of it
+}
+
+TEST(SimDetections, WhiteNoiseAcrossTheHeadingByItsRatio) {
+  // No drift, the white noise across the heading half of that along it; the default is the same
+  // both ways (the test above).
+  sim::Scenario sc = sim::loadScenario(std::string(DLSLOT_SOURCE_DIR) + "/config/scenarios/highway.yaml");
+  sc.frames = 15;
+  sc.detector.position_noise_across_ratio = 0.5;
+  const Eigen::Vector3d e = alongCorrelationAndRms(carErrors(sc));
+  EXPECT_LT(std::abs(e.x()), 0.3);  // still white
+  EXPECT_NEAR(e.z() / e.y(), 0.5, 0.12);
 }

@@ -82,6 +82,22 @@ TEST(SimScenario, BadFilesNameTheFileAndTheKey) {
   EXPECT_NE(interval.find("ground.wavelength_m"), std::string::npos) << interval;
 }
 
+TEST(SimScenario, TheDetectorsAcrossKeysDefaultToTheAlongOnes) {
+  // The across drift's time follows drift_time_s unless given; the white noise is the same both
+  // ways unless the ratio is given, and a ratio must be positive.
+  const sim::Scenario drift = sim::loadScenario(writeTemp(std::string(kMinimal) + "detector: {drift_time_s: 2}\n"));
+  EXPECT_DOUBLE_EQ(drift.detector.drift_across_time_s, 2.0);
+  EXPECT_DOUBLE_EQ(drift.detector.position_noise_across_ratio, 1.0);
+  const sim::Scenario across = sim::loadScenario(writeTemp(
+      std::string(kMinimal) +
+      "detector: {drift_time_s: 2, drift_across_time_s: 1.3, position_noise_across_ratio: 0.6}\n"));
+  EXPECT_DOUBLE_EQ(across.detector.drift_time_s, 2.0);
+  EXPECT_DOUBLE_EQ(across.detector.drift_across_time_s, 1.3);
+  EXPECT_DOUBLE_EQ(across.detector.position_noise_across_ratio, 0.6);
+  const std::string zero = errorOf(std::string(kMinimal) + "detector: {position_noise_across_ratio: 0}\n");
+  EXPECT_NE(zero.find("detector.position_noise_across_ratio"), std::string::npos) << zero;
+}
+
 TEST(SimWorld, NoSolidsOverlapAndMotionIsSmooth) {
   for (const std::string name : {"urban-static", "intersection", "highway", "parking-lot"}) {
     const sim::Scenario sc = sim::test::shippedScenario(name, 120);

@@ -21,9 +21,14 @@ Box noisy(const DetectorTarget& target, const DetectorSpec& spec, Rng& rng) {
   Box b = truth;
   const double range = truth.center.head<2>().norm();
   const double sigma = spec.position_noise_m + spec.position_noise_per_m * range;
-  b.center += Eigen::Vector3d(rng.normal(0, sigma), rng.normal(0, sigma), rng.normal(0, 0.5 * sigma));
-  const double drift = spec.drift_m + spec.drift_per_m * range;
   const Eigen::Vector2d along(std::cos(truth.yaw), std::sin(truth.yaw)), across(-along.y(), along.x());
+  Eigen::Vector3d white(rng.normal(0, sigma), rng.normal(0, sigma), rng.normal(0, 0.5 * sigma));
+  // The same in every direction, the draws serve as x and y (a scenario without the ratio keeps
+  // its bytes); otherwise as along and across the heading.
+  if (spec.position_noise_across_ratio != 1.0)
+    white.head<2>() = white.x() * along + spec.position_noise_across_ratio * white.y() * across;
+  b.center += white;
+  const double drift = spec.drift_m + spec.drift_per_m * range;
   b.center.head<2>() += drift * (target.drift.x() * along + spec.drift_across_ratio * target.drift.y() * across);
   for (int i = 0; i < 3; ++i) b.size[i] *= std::max(0.5, 1.0 + rng.normal(0, spec.size_noise));
   const bool vehicle = isVehicle(truth.type);
@@ -59,7 +64,7 @@ kitti::LabelRow detectionRow(int frame, int track_id, const Box& box, double sco
 
 }  // namespace
 
-Eigen::Vector2d driftProcess(uint64_t key, double t_s, double time_s) {
+Eigen::Vector2d driftProcess(uint64_t key, double t_s, const Eigen::Vector2d& time_s) {
   // E[cos(w dt)] over a Cauchy w of scale 1/time is exp(-|dt| / time); each cosine of a random
   // phase has variance 1/2, so sqrt(2 / kTerms) makes the sum's variance 1.
   constexpr int kTerms = 32;
@@ -67,7 +72,7 @@ Eigen::Vector2d driftProcess(uint64_t key, double t_s, double time_s) {
   for (int c = 0; c < 2; ++c) {
     Rng rng(streamKey({key, static_cast<uint64_t>(c)}));
     for (int k = 0; k < kTerms; ++k) {
-      const double w = std::tan(M_PI * (rng.uniform() - 0.5)) / time_s;
+      const double w = std::tan(M_PI * (rng.uniform() - 0.5)) / time_s[c];
       const double phase = rng.uniform(0.0, 2.0 * M_PI);
       out[c] += std::cos(w * t_s + phase);
     }

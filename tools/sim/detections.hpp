@@ -22,10 +22,11 @@ struct DetectorTarget {
   Eigen::Vector2d drift = Eigen::Vector2d::Zero();  // driftProcess of this object now (along, across)
 };
 
-// Two independent unit-variance random processes of time (s), correlated by exp(-|dt| / time_s),
-// the same for the same key: a sum of cosines whose frequencies are drawn from that correlation's
-// spectrum (a Cauchy distribution of scale 1 / time_s), so any frame can be drawn alone.
-Eigen::Vector2d driftProcess(uint64_t key, double t_s, double time_s);
+// Two independent unit-variance random processes of time (s), component c correlated by
+// exp(-|dt| / time_s[c]), the same for the same key: a sum of cosines whose frequencies are drawn
+// from that correlation's spectrum (a Cauchy distribution of scale 1 / time_s[c]), so any frame can
+// be drawn alone.
+Eigen::Vector2d driftProcess(uint64_t key, double t_s, const Eigen::Vector2d& time_s);
 
 // Which structures are persistent false-positive sources, chosen once per sequence.
 std::vector<bool> chooseGhosts(const World& world, const DetectorSpec& spec, uint64_t key);

@@ -227,11 +227,13 @@ void readDetector(Section s, DetectorSpec& d) {
   s.fraction("max_probability", d.max_probability);
   s.optional("position_noise_m", d.position_noise_m);
   s.optional("position_noise_per_m", d.position_noise_per_m);
+  if (s.has("position_noise_across_ratio")) d.position_noise_across_ratio = s.positive("position_noise_across_ratio");
   s.optional("drift_m", d.drift_m);
   s.optional("drift_per_m", d.drift_per_m);
   if (d.drift_m < 0 || d.drift_per_m < 0) s.fail("drift_m", "expected drift_m and drift_per_m >= 0");
   s.fraction("drift_across_ratio", d.drift_across_ratio);
   if (s.has("drift_time_s")) d.drift_time_s = s.positive("drift_time_s");
+  d.drift_across_time_s = s.has("drift_across_time_s") ? s.positive("drift_across_time_s") : d.drift_time_s;
   s.optional("yaw_noise_deg", d.yaw_noise);
   if (s.has("yaw_noise_deg")) d.yaw_noise *= kDeg;
   s.fraction("heading_flip", d.heading_flip);

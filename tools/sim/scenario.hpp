@@ -148,12 +148,15 @@ struct LabelSpec {
 struct DetectorSpec {            // simulated 3D detector (SECOND-like probabilities as scores)
   double points_for_half = 8.0;  // detection probability p_max (1 - 2^(-points / points_for_half))
   double max_probability = 0.97;
-  double position_noise_m = 0.08, position_noise_per_m = 0.003;  // white, per axis (x, y)
+  // White noise of the centre, per axis: position_noise_m + position_noise_per_m x range along the
+  // object's heading, position_noise_across_ratio x that across it (1: the same in every direction).
+  double position_noise_m = 0.08, position_noise_per_m = 0.003, position_noise_across_ratio = 1.0;
   // A box's centre also drifts slowly off the object's (a partly seen car's box follows what is
   // seen of it): standard deviation drift_m + drift_per_m x range along the object's heading,
-  // drift_across_ratio x that across it, correlated over drift_time_s (exp(-dt / time)). Off by
+  // drift_across_ratio x that across it, correlated over drift_time_s along and
+  // drift_across_time_s across (exp(-dt / time); the latter defaults to the former). Off by
   // default; config/scenarios/README.md has the values measured on KITTI's PointRCNN boxes.
-  double drift_m = 0.0, drift_per_m = 0.0, drift_across_ratio = 0.2, drift_time_s = 3.0;
+  double drift_m = 0.0, drift_per_m = 0.0, drift_across_ratio = 0.2, drift_time_s = 3.0, drift_across_time_s = 3.0;
   double yaw_noise = 0.04;     // rad
   double heading_flip = 0.02;  // chance a vehicle's heading is off by pi
   double size_noise = 0.04;    // relative

@@ -70,7 +70,7 @@ Simulation::FrameData Simulation::frame(int index, int threads) {
     Eigen::Vector2d drift = Eigen::Vector2d::Zero();
     if (scenario_.detector.drift_m > 0 || scenario_.detector.drift_per_m > 0)
       drift = driftProcess(streamKey({scenario_.seed, 8, static_cast<uint64_t>(agent_of[k])}), index * in.period_s,
-                           scenario_.detector.drift_time_s);
+                           {scenario_.detector.drift_time_s, scenario_.detector.drift_across_time_s});
     targets.push_back({box, id, view.points, drift});
   }
   Rng rng(streamKey({scenario_.seed, 7, static_cast<uint64_t>(index)}));

@@ -552,7 +552,9 @@ int run(int argc, char** argv) {
                                velocityErrorByRange(pairs, 10.0, 0, 4, 10),
                                velocityErrorByRange(pairs, 10.0, 5, std::numeric_limits<int>::max(), 10));
       plots.push_back("plots/velocity_error_by_range.png");
-      plotVelocityErrorByAge((out / "plots" / "velocity_error_by_age.png").string(), velocityErrorByAge(pairs, 20, 10));
+      constexpr int kLastAge = 20;  // the report's oldest age group starts there
+      plotVelocityErrorByAge((out / "plots" / "velocity_error_by_age.png").string(),
+                             velocityErrorByAge(pairs, kLastAge, 10), kLastAge);
       plots.push_back("plots/velocity_error_by_age.png");
     }
     writeMetricsJson((out / "metrics.json").string(), metrics);

@@ -219,7 +219,7 @@ void plotVelocityErrorByRange(const std::string& path, const std::vector<Velocit
   plot.save(path);
 }
 
-void plotVelocityErrorByAge(const std::string& path, const std::vector<VelocityBin>& bins) {
+void plotVelocityErrorByAge(const std::string& path, const std::vector<VelocityBin>& bins, int last_age) {
   const auto age = [](const VelocityBin& b) { return b.from; };
   const Series error = binSeries(bins, false, age), own = binSeries(bins, true, age);
   Eigen::Vector2d lo(0, 0), hi = lo;
@@ -227,9 +227,8 @@ void plotVelocityErrorByAge(const std::string& path, const std::vector<VelocityB
   bounds(own, lo, hi);
   hi.y() *= 1.15;
   Plot plot(lo, hi, false);
-  const std::string last = bins.empty() ? "" : " (" + std::to_string(static_cast<int>(bins.back().from)) + ": that and older)";
-  plot.axes("track age [scans since its first output]" + last, "velocity error, RMS [m/s]",
-            "velocity error of moving objects by track age");
+  plot.axes("track age [scans since its first output; " + std::to_string(last_age) + ": that and older]",
+            "velocity error, RMS [m/s]", "velocity error of moving objects by track age");
   plot.line(error, kColours[0], 2, "error", Plot::Dots::Every);
   plot.line(own, kColours[0], 1, "its own sigma", Plot::Dots::Every, true);
   plot.save(path);

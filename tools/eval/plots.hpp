@@ -25,7 +25,8 @@ void plotErrorOverDistance(const std::string& path, const std::map<std::string, 
 void plotVelocityErrorByRange(const std::string& path, const std::vector<VelocityBin>& young,
                               const std::vector<VelocityBin>& older);
 
-// The same against the track's age: how soon a new track's velocity can be trusted.
-void plotVelocityErrorByAge(const std::string& path, const std::vector<VelocityBin>& bins);
+// The same against the track's age (velocityErrorByAge's bins, last_age holding the older tracks):
+// how soon a new track's velocity can be trusted.
+void plotVelocityErrorByAge(const std::string& path, const std::vector<VelocityBin>& bins, int last_age);
 
 }  // namespace dlslot::eval

@@ -550,19 +550,8 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
           registrationMeasurement(m->second.M, m->second.information, m->second.X_prev, m->second.X_cur);
       addFactor(RegistrationFactor::Create(rm.A_meas, rm.sqrt_info), true,
                 {ego_prev->pose->data(), ego_cur->pose->data(), prev, change});
-    } else if (const auto sight = track.sight_speeds.find(f);
-               config_.line_of_sight_chain && track.velocity_from_chain && sight != track.sight_speeds.end() &&
-               sight->second.points >= config_.line_of_sight_min_points && ego_prev && ego_cur) {
-      // No registration: the face's speed along the line of sight (robust: 13-31 % of the pairs
-      // are over 1 m/s off, line_of_sight.hpp). Only on a chain that spans the window: a young
-      // chain has too little else to outvote a face that jumps between scans (intersection seed 7:
-      // two such pairs took a car's young chain to 12 m/s against its 6, and it then braked to
-      // 0.6 against 3; the young path's median of pairs is robust to them).
-      const double dt = secondsBetween(f - 1, f);
-      const SightSpeed& s = sight->second;
-      addFactor(SightSpeedFactor::Create(Eigen::Vector3d(s.u.x(), s.u.y(), 0.0), s.speed * dt - s.sensor_displacement,
-                                         config_.line_of_sight_sigma * dt),
-                true, {ego_prev->pose->data(), ego_cur->pose->data(), prev, change});
+    } else if (track.sight_on_chain) {
+      addSightSpeedFactor(track, f);
     }
     auto before = track.changes.find(f - 2);
     if (before != track.changes.end())
@@ -573,6 +562,35 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
       addFactor(ConstantAccelerationFactor::Create(config_.constant_acceleration_sigma), false,
                 {before2->second->data(), before->second->data(), change});
   }
+  // The faces' speeds go on the chain once it spans the window, and then every pair in the window
+  // the young path read: a young chain has too little else to outvote a face that jumps between
+  // scans (intersection seed 7: two such pairs took a car's young chain to 12 m/s against its 6,
+  // and it then braked to 0.6 against 3; the young path's median of pairs is robust to them), and
+  // a chain that took only the pairs after its velocity was first read from it had none of them
+  // at that first read.
+  if (config_.line_of_sight_chain && !track.sight_on_chain &&
+      static_cast<int>(track.changes.size()) >= config_.window_size - 1) {
+    track.sight_on_chain = true;
+    for (const auto& [g, c] : track.changes)
+      if (!track.motions.count(g + 1)) addSightSpeedFactor(track, g + 1);
+  }
+}
+
+void SlidingWindow::addSightSpeedFactor(const Track& track, int f) {
+  // The face's speed along the line of sight between f - 1 and f where no registration measured
+  // the motion (robust: 13-31 % of the pairs are over 1 m/s off, line_of_sight.hpp).
+  const auto sight = track.sight_speeds.find(f);
+  const EgoFrame *ego_prev = findFrame(f - 1), *ego_cur = findFrame(f);
+  const auto pose = track.poses.find(f - 1);
+  const auto change = track.changes.find(f - 1);
+  if (sight == track.sight_speeds.end() || sight->second.points < config_.line_of_sight_min_points || !ego_prev ||
+      !ego_cur || pose == track.poses.end() || change == track.changes.end())
+    return;
+  const double dt = secondsBetween(f - 1, f);
+  const SightSpeed& s = sight->second;
+  addFactor(SightSpeedFactor::Create(Eigen::Vector3d(s.u.x(), s.u.y(), 0.0), s.speed * dt - s.sensor_displacement,
+                                     config_.line_of_sight_sigma * dt),
+            true, {ego_prev->pose->data(), ego_cur->pose->data(), pose->second->data(), change->second->data()});
 }
 
 void SlidingWindow::startStraight(const Track& track, int f, double* change, const Eigen::Vector3d& displacement) {
@@ -891,6 +909,7 @@ SmoothedPose SlidingWindow::slide() {
     track->changes.clear();
     track->velocity.reset();
     track->velocity_from_chain = false;
+    track->sight_on_chain = false;
     track->past_boxes.clear();
   }
   // Tracks with nothing left in the window are forgotten (first_seen_ keeps their age).

@@ -83,6 +83,7 @@ class SlidingWindow {
     std::optional<Eigen::Vector3d> velocity;
     Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();  // of `velocity`, (m/s)^2
     bool velocity_from_chain = false;
+    bool sight_on_chain = false;  // its faces' speeds are factors on its chain (extendChain)
     TrackFront front;  // which end its boxes' heading points to (track_front.hpp)
     // Per-object registration: the object's accumulated points (its model, world frame of its
     // latest scan) and the same prepared as the next frame's source (the latest scan alone when
@@ -165,6 +166,9 @@ class SlidingWindow {
   std::optional<SpeedFit> windowMotion(const Track& track, const std::optional<WindowHeading>& heading) const;
   void addTrackObservation(Track& track, int frame);
   void extendChain(Track& track, int frame, const Pose& o);
+  // The face's speed along the line of sight over f - 1 -> f as a factor on the chain, when the
+  // track has one of enough points and its poses and the ego's for both frames are in the window.
+  void addSightSpeedFactor(const Track& track, int f);
   // The prior that starts a vehicle's chain straight on its first pose change c_{f-1}^f, which
   // moved it by `displacement` (world), at the track's speed (vehicle_motion_factor.hpp).
   void startStraight(const Track& track, int f, double* change, const Eigen::Vector3d& displacement);

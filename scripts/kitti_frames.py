@@ -1,7 +1,7 @@
 """KITTI tracking files and frames for the analysis scripts: the labels and detectors a folder
-holds, 4x4 transforms as nested lists, and the transform from a sequence's rectified camera-0 coordinates (its labels) to the world of its
-velodyne poses (ROOT/poses/SSSS.txt as in AB3DMOT's data, or ROOT/training/poses/SSSS.txt as the
-simulator writes them)."""
+holds, 4x4 transforms as nested lists, and the transform from a sequence's rectified camera-0
+coordinates (its labels) to the world of its velodyne poses (ROOT/poses/SSSS.txt as in AB3DMOT's
+data, or ROOT/training/poses/SSSS.txt as the simulator writes them)."""
 import glob
 import os
 import sys

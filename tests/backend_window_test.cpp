@@ -669,6 +669,43 @@ TEST(BackendSlidingWindow, AWalkerStartedStillIsJudgedAgainAsItsLineGrows) {
   EXPECT_LT(standing_at_2, 380);
 }
 
+// A still track is published with zero velocity and a covariance of that zero about the truth:
+// its window's evidence of motion, spread and mean. A walker at 1.2 m/s whose first boxes cannot
+// tell it from standing (published still in some frames) keeps its true velocity inside the 95 %
+// ellipse there; a standing one's sigma stays near its boxes' line's (0.15 m box noise).
+TEST(BackendSlidingWindow, AStillTracksVelocityCovarianceCoversWhatItMayBeDoing) {
+  for (const double speed : {1.2, 0.0}) {
+    int still = 0, inside = 0;
+    double variance = 0;
+    for (unsigned seed = 1; seed <= 10; ++seed) {
+      const SimScene scene = walkerScene(speed, 0.15, 0.3, seed);
+      BackendConfig c;
+      c.compute_covariance = true;
+      c.walker_line_span_s = 2.0;
+      c.switch_min_sigmas = 3.0;
+      SlidingWindow window(c);
+      for (const BackendOutput& out : run(window, scene.generate(40)))
+        for (const TrackEstimate& e : out.tracks) {
+          if (e.id != 5 || e.dynamic) continue;
+          const Eigen::Matrix2d C = e.velocity_covariance.topLeftCorner<2, 2>();
+          ASSERT_GT(C.determinant(), 0.0);
+          EXPECT_EQ(e.velocity.norm(), 0.0);
+          const Eigen::Vector2d truth(0.0, speed);  // the walker heads along +y
+          ++still;
+          inside += truth.dot(C.inverse() * truth) <= 5.991;  // chi-square, 2 degrees of freedom, 95 %
+          variance += 0.5 * C.trace();
+        }
+    }
+    std::printf("pedestrian at %.1f m/s published still in %d frames: %d inside the 95 %% ellipse, sigma %.2f m/s\n",
+                speed, still, inside, std::sqrt(variance / still));
+    ASSERT_GT(still, speed > 0 ? 10 : 300);
+    EXPECT_GE(inside, 0.95 * still);
+    if (speed == 0.0) {
+      EXPECT_LT(std::sqrt(variance / still), 0.5);
+    }
+  }
+}
+
 namespace {
 
 // The mean velocity error (m/s, frames 15-39) of a cyclist at 4.5 m/s tracked on a pedestrian

@@ -116,6 +116,8 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   require(c.velocity_frames >= 1, s, "velocity_frames", "a frame count >= 1");
   s.get("walker_line_span_s", c.walker_line_span_s);
   require(c.walker_line_span_s >= 0.0, s, "walker_line_span_s", "a span >= 0 (s)");
+  s.get("walker_rms_speed", c.walker_rms_speed);
+  require(c.walker_rms_speed >= 0.0, s, "walker_rms_speed", "a speed >= 0 (m/s)");
   s.get("switch_min_sigmas", c.switch_min_sigmas);
   require(c.switch_min_sigmas >= 0.0, s, "switch_min_sigmas", "a number of sigmas >= 0");
   require(c.static_max_speed >= 0.0, s, "static_max_speed", "a speed >= 0 (m/s)");

@@ -138,6 +138,9 @@ struct BackendConfig {
   // A pedestrian's (any non-vehicle's) velocity: the line through its boxes of the last this many
   // seconds, the window's and those that left it; the window's alone when shorter.
   double walker_line_span_s = 0.0;
+  // The RMS speed of walking pedestrians (m/s): a walker's line is fused with a zero-mean prior of
+  // this spread (withSpeedPrior). 0: none.
+  double walker_rms_speed = 0.0;
   // A still object is judged again at every frame, a pedestrian by its line, a vehicle by what its
   // points measured over the last frames: dynamic when faster than static_max_speed and this many
   // standard deviations of that velocity (0: never).

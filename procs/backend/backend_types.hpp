@@ -50,8 +50,8 @@ struct TrackEstimate {
   Pose pose = Pose::Identity();  // T_world_object at the newest frame
   Eigen::Vector3d size = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();          // world frame, m/s
-  // Of the velocity, world frame, (m/s)^2. Zero for a static track (still by its model) and when
-  // covariances are not computed.
+  // Of the velocity, world frame, (m/s)^2; for a static track (still by its model, velocity zero)
+  // its window's motion evidence about zero. Zero when covariances are not computed.
   Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // world frame, rad/s
   bool dynamic = false;

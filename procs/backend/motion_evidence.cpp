@@ -1,5 +1,6 @@
 #include "backend/motion_evidence.hpp"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -94,6 +95,16 @@ Eigen::Vector3d velocityAlongHeading(const SpeedFit& fit, const Eigen::Vector2d&
   const double w = var_heading / (var_heading + var_fit);  // weight of the positions' estimate
   Eigen::Vector3d out = fit.velocity;
   out.head<2>() -= (1.0 - w) * v_across * across;
+  return out;
+}
+
+PlanarVelocity withSpeedPrior(const Eigen::Vector2d& velocity, const Eigen::Matrix2d& covariance, double rms_speed) {
+  if (!(rms_speed > 0)) return {velocity, covariance};
+  const Eigen::Matrix2d information = covariance.inverse();
+  const Eigen::Matrix2d prior_information = (2.0 / (rms_speed * rms_speed)) * Eigen::Matrix2d::Identity();
+  PlanarVelocity out;
+  out.covariance = (information + prior_information).inverse();
+  out.velocity = out.covariance * information * velocity;
   return out;
 }
 

@@ -39,6 +39,20 @@ std::optional<SpeedFit> fitSpeedAmongOutliers(const std::vector<TimedPosition>& 
 // with that component replaced by the variance-weighted mean of the two.
 Eigen::Vector3d velocityAlongHeading(const SpeedFit& fit, const Eigen::Vector2d& heading, double heading_sigma);
 
+// A bird's-eye velocity with its covariance.
+struct PlanarVelocity {
+  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity();
+};
+
+// The linear minimum-mean-square-error velocity of an object of a kind that moves in no preferred
+// direction at `rms_speed` (the RMS speed of its moving members; a linear estimator needs no more
+// than the second moments): the measured `velocity` (full-rank `covariance`) fused by information
+// with a zero-mean prior of rms_speed^2 / 2 per axis. A walker's line through its first two or
+// three boxes (1-2 m/s uncertain) is drawn toward standing as far as it is uncertain; a line over
+// seconds (0.1-0.2 m/s) hardly moves. rms_speed <= 0: unchanged.
+PlanarVelocity withSpeedPrior(const Eigen::Vector2d& velocity, const Eigen::Matrix2d& covariance, double rms_speed);
+
 // Evidence of motion: a speed above `min_speed` and above `min_sigmas` standard deviations of it
 // (box noise alone makes a still object's fitted speed a sigma or so).
 inline bool movesBeyond(double speed, double sigma, double min_speed, double min_sigmas) {

@@ -472,6 +472,19 @@ SlidingWindow::LineVelocity SlidingWindow::youngVehicleVelocity(const Track& tra
   return out;
 }
 
+Eigen::Matrix3d SlidingWindow::stillVelocityCovariance(const Track& track) const {
+  // A still track is published with zero velocity; how far that may be off is what the window says
+  // of its motion: the evidence's covariance plus its mean squared, the second moment about the
+  // published zero. A walker whose boxes cannot yet tell it from standing is still by the test but
+  // 1.3 m/s off, which a zero covariance hid from every consumer (and from dlslot-eval's NEES).
+  // With no box in the window (a landmark out of view), the speed the still test lets through.
+  const std::optional<LineVelocity> line = boxLineVelocity(track);
+  if (!line) return config_.static_max_speed * config_.static_max_speed * Eigen::Matrix3d::Identity();
+  const bool measured = !track.motions.empty() || !track.sight_speeds.empty();
+  const LineVelocity v = isVehicle(track.type) && measured ? youngVehicleVelocity(track, *line) : *line;
+  return v.covariance3() + v.velocity * v.velocity.transpose();
+}
+
 void SlidingWindow::startTrack(Track& track, int frame) {
   // Static or dynamic from the positions of the trajectory in the window (III-D); the tracker's
   // guess only when the window has too little of it.
@@ -735,6 +748,7 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
     if (!e.dynamic) {
       block = track.landmark->data();
       e.pose = fromBlock(block);
+      if (config_.compute_covariance) e.velocity_covariance = stillVelocityCovariance(track);
     } else {
       const auto& [f_last, o_last] = *track.poses.rbegin();
       block = f_last == t ? o_last->data() : nullptr;
@@ -754,8 +768,12 @@ void SlidingWindow::fillTracks(BackendOutput& out) {
         // pose change swung 2-30 m/s on walkers the tracker fed a stray box or the chain a wrong
         // turn (intersection seeds 3 and 10: 6 and 18 errors > 3 m/s; none with the line), and the
         // line is better on the tuning seeds 1-5 (pedestrian velocity RMSE 0.308 / 0.442 / 0.657 /
-        // 0.489 / 0.474 -> 0.296 / 0.422 / 0.413 / 0.415 / 0.422 m/s).
-        if (const auto line = boxLineVelocity(track)) {
+        // 0.489 / 0.474 -> 0.296 / 0.422 / 0.413 / 0.415 / 0.422 m/s). Drawn toward standing by
+        // the walkers' speed prior as far as the line is uncertain (a young walker's).
+        if (std::optional<LineVelocity> line = boxLineVelocity(track)) {
+          const PlanarVelocity v = withSpeedPrior(line->velocity.head<2>(), line->covariance, config_.walker_rms_speed);
+          line->velocity.head<2>() = v.velocity;
+          line->covariance = v.covariance;
           track.velocity = line->velocity;
           track.velocity_covariance = line->covariance3();
         }

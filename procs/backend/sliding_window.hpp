@@ -150,6 +150,8 @@ class SlidingWindow {
   // measured (registered_velocity.hpp); without registrations, with its speed along the line of
   // sight over its last scan pairs (line_of_sight.hpp); else the line as it is.
   LineVelocity youngVehicleVelocity(const Track& track, const LineVelocity& line) const;
+  // The covariance of a still track's published (zero) velocity about the truth.
+  Eigen::Matrix3d stillVelocityCovariance(const Track& track) const;
   // The velocities over ground its points measured: its registrations from first_frame on
   // (registered_velocity.hpp), else its face's speed along the line of sight over the last pairs.
   std::vector<VelocityEvidence> pointsVelocities(const Track& track, int first_frame) const;

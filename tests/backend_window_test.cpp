@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
 
 #include "backend/sliding_window.hpp"
 #include "backend_scene.hpp"
@@ -636,21 +637,28 @@ TEST(BackendSlidingWindow, AWalkersLineOutlastsTheWindow) {
 
 namespace {
 
-// Frames a pedestrian at `speed` m/s (boxes 0.15 m off, the tracker guessing it still) is
-// published still, over 10 seeds, after its first output; a still one judged again at every
-// frame at `switch_sigmas` (0: never).
-int framesPublishedStill(double speed, double switch_sigmas) {
-  int still = 0;
+// Every estimate of a pedestrian at `speed` m/s (boxes 0.15 m off, the tracker guessing it still)
+// over 10 seeds of 40 frames, its line over 2 s; a still one judged again at every frame at
+// `switch_sigmas` (0: never).
+void forEachWalkerEstimate(double speed, double switch_sigmas, bool covariance,
+                           const std::function<void(const TrackEstimate&)>& f) {
   for (unsigned seed = 1; seed <= 10; ++seed) {
     const SimScene scene = walkerScene(speed, 0.15, 0.3, seed);
     BackendConfig c;
-    c.compute_covariance = false;
+    c.compute_covariance = covariance;
     c.walker_line_span_s = 2.0;
     c.switch_min_sigmas = switch_sigmas;
     SlidingWindow window(c);
     for (const BackendOutput& out : run(window, scene.generate(40)))
-      for (const TrackEstimate& e : out.tracks) still += e.id == 5 && !e.dynamic;
+      for (const TrackEstimate& e : out.tracks)
+        if (e.id == 5) f(e);
   }
+}
+
+// Frames the pedestrian is published still after its first output.
+int framesPublishedStill(double speed, double switch_sigmas) {
+  int still = 0;
+  forEachWalkerEstimate(speed, switch_sigmas, false, [&](const TrackEstimate& e) { still += !e.dynamic; });
   return still;
 }
 
@@ -677,25 +685,16 @@ TEST(BackendSlidingWindow, AStillTracksVelocityCovarianceCoversWhatItMayBeDoing)
   for (const double speed : {1.2, 0.0}) {
     int still = 0, inside = 0;
     double variance = 0;
-    for (unsigned seed = 1; seed <= 10; ++seed) {
-      const SimScene scene = walkerScene(speed, 0.15, 0.3, seed);
-      BackendConfig c;
-      c.compute_covariance = true;
-      c.walker_line_span_s = 2.0;
-      c.switch_min_sigmas = 3.0;
-      SlidingWindow window(c);
-      for (const BackendOutput& out : run(window, scene.generate(40)))
-        for (const TrackEstimate& e : out.tracks) {
-          if (e.id != 5 || e.dynamic) continue;
-          const Eigen::Matrix2d C = e.velocity_covariance.topLeftCorner<2, 2>();
-          ASSERT_GT(C.determinant(), 0.0);
-          EXPECT_EQ(e.velocity.norm(), 0.0);
-          const Eigen::Vector2d truth(0.0, speed);  // the walker heads along +y
-          ++still;
-          inside += truth.dot(C.inverse() * truth) <= 5.991;  // chi-square, 2 degrees of freedom, 95 %
-          variance += 0.5 * C.trace();
-        }
-    }
+    forEachWalkerEstimate(speed, 3.0, true, [&](const TrackEstimate& e) {
+      if (e.dynamic) return;
+      const Eigen::Matrix2d C = e.velocity_covariance.topLeftCorner<2, 2>();
+      EXPECT_GT(C.determinant(), 0.0);
+      EXPECT_EQ(e.velocity.norm(), 0.0);
+      const Eigen::Vector2d truth(0.0, speed);  // the walker heads along +y
+      ++still;
+      inside += C.determinant() > 0 && truth.dot(C.inverse() * truth) <= 5.991;  // chi-square, 2 dof, 95 %
+      variance += 0.5 * C.trace();
+    });
     std::printf("pedestrian at %.1f m/s published still in %d frames: %d inside the 95 %% ellipse, sigma %.2f m/s\n",
                 speed, still, inside, std::sqrt(variance / still));
     ASSERT_GT(still, speed > 0 ? 10 : 300);

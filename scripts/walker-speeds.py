@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """How fast walking pedestrians walk, from labels: the spread the backend's walker speed prior uses.
 
-usage: scripts/walker-speeds.py KITTI_DIR [SEQUENCE...]   (default: every sequence with poses)
-KITTI_DIR as for scripts/vehicle-yaw-rates.py. For every labelled Pedestrian and every frame with
+usage: scripts/walker-speeds.py KITTI_DIR [SEQUENCE...]
+(default: every sequence with poses, and 0017 when labelled: pedestrians crossing in front of a
+parked car, so its camera frame is a world frame). KITTI_DIR as for scripts/vehicle-yaw-rates.py. For every labelled Pedestrian and every frame with
 labels 0.5 s before and after, its velocity is the central difference of its world centres over
 +-0.5 s. Printed: the RMS speed and percentiles of the walkers faster than 0.5 m/s (slower, the
 poses' 0.1-0.15 m jitter is most of the motion), which is the prior's RMS speed; and the share of
@@ -23,6 +24,9 @@ def main():
         sys.exit(__doc__)
     root = sys.argv[1]
     sequences = sys.argv[2:] or yaw.sequences_with_poses(root)
+    if not sys.argv[2:] and "0017" not in sequences and os.path.exists(
+            os.path.join(root, "training", "label_02", "0017.txt")):
+        sequences.append("0017")
     if not sequences:
         sys.exit(f"{root}: no poses/SSSS.txt or training/poses/SSSS.txt")
     speeds, standing = [], 0

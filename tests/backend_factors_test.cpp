@@ -699,7 +699,7 @@ TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
   for (const char* bad : {"{Cyclist: 0}", "{Cyclist: fast}", "[0.3]"}) expectRefused("heading_sigma_by_type", bad);
   EXPECT_EQ(c.walker_line_span_s, 2.0);
   expectRefused("walker_line_span_s", "-1");
-  EXPECT_EQ(c.walker_rms_speed, 1.2);
+  EXPECT_EQ(c.walker_rms_speed, 1.5);
   for (const char* bad : {"-1", "slow"}) expectRefused("walker_rms_speed", bad);
   EXPECT_EQ(c.switch_min_sigmas, 3.0);
   expectRefused("switch_min_sigmas", "-1");

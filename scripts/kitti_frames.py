@@ -1,8 +1,11 @@
 """KITTI tracking files and frames for the analysis scripts: the labels and detectors a folder
 holds, 4x4 transforms as nested lists, and the transform from a sequence's rectified camera-0
 coordinates (its labels) to the world of its velodyne poses (ROOT/poses/SSSS.txt as in AB3DMOT's
-data, or ROOT/training/poses/SSSS.txt as the simulator writes them)."""
+data, or ROOT/training/poses/SSSS.txt as the simulator writes them); labelled objects as tracks in
+that world."""
+import collections
 import glob
+import math
 import os
 import sys
 
@@ -42,6 +45,42 @@ def camera_to_world(root, seq):
         return lambda f: cam_to_velo
     poses = [mat([float(x) for x in line.split()]) for line in open(path)]
     return lambda f: mul(poses[f], cam_to_velo)
+
+
+def sequences_with_poses(root):
+    """The sequences with velodyne poses under ROOT/poses or ROOT/training/poses."""
+    names = set()
+    for d in (os.path.join(root, "poses"), os.path.join(root, "training", "poses")):
+        if os.path.isdir(d):
+            names.update(f[:-4] for f in os.listdir(d) if f.endswith(".txt"))
+    return sorted(names)
+
+
+def world_label_tracks(root, seq, classes, to_world=None):
+    """The labels of the given classes in sequence seq as tracks: id -> frame -> (x, y, heading) in
+    the world of to_world (default camera_to_world(root, seq)); exits naming the line of a label
+    with too few fields."""
+    to_world = to_world or camera_to_world(root, seq)
+    tracks = collections.defaultdict(dict)
+    path = os.path.join(root, "training", "label_02", seq + ".txt")
+    for n, line in enumerate(open(path), 1):
+        t = line.split()
+        if len(t) < 17:
+            sys.exit(f"{path}:{n}: expected 17 fields, got {len(t)}")
+        if t[2] in classes:
+            f = int(t[0])
+            p = apply(to_world(f), [float(t[13]), float(t[14]), float(t[15])])
+            # A camera label's forward axis is (cos ry, 0, -sin ry) in camera coordinates.
+            ry = float(t[16])
+            o = apply(to_world(f), [0.0, 0.0, 0.0])
+            q = apply(to_world(f), [math.cos(ry), 0.0, -math.sin(ry)])
+            tracks[int(t[1])][f] = (p[0], p[1], math.atan2(q[1] - o[1], q[0] - o[0]))
+    return tracks
+
+
+def percentile(v, q):
+    """The q-quantile of the sorted list v."""
+    return v[min(len(v) - 1, int(q * len(v)))]
 
 
 def labels_and_detectors(argv, usage):

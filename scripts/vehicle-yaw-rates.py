@@ -15,7 +15,7 @@ headings twice, so their noise is in it, and its 1 s spans smooth a sharp turn-i
 import collections, math, os, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from kitti_frames import apply, camera_to_world  # noqa: E402
+from kitti_frames import percentile, sequences_with_poses, world_label_tracks  # noqa: E402
 
 VEHICLES = ("Car", "Van", "Truck")
 HALF = 5  # frames: +-0.5 s at 10 Hz
@@ -26,13 +26,6 @@ def speed_at(track, f):
     """The speed at frame f: the central difference of the centres HALF frames either side."""
     a, b = track[f - HALF], track[f + HALF]
     return math.hypot(b[0] - a[0], b[1] - a[1]) / SPAN
-
-
-def heading(to_world, ry):
-    # A camera label's forward axis is (cos ry, 0, -sin ry) in camera coordinates.
-    o = apply(to_world, [0.0, 0.0, 0.0])
-    p = apply(to_world, [math.cos(ry), 0.0, -math.sin(ry)])
-    return math.atan2(p[1] - o[1], p[0] - o[0])
 
 
 def yaw_rate_at(track, f):
@@ -48,18 +41,6 @@ def modulo_pi(a):
     return (a + math.pi / 2) % math.pi - math.pi / 2
 
 
-def sequences_with_poses(root):
-    names = set()
-    for d in (os.path.join(root, "poses"), os.path.join(root, "training", "poses")):
-        if os.path.isdir(d):
-            names.update(f[:-4] for f in os.listdir(d) if f.endswith(".txt"))
-    return sorted(names)
-
-
-def percentile(v, q):
-    return v[min(len(v) - 1, int(q * len(v)))]
-
-
 def main():
     if len(sys.argv) < 2:
         sys.exit(__doc__)
@@ -70,18 +51,7 @@ def main():
     rates, lateral, longitudinal, jerk = [], [], [], []
     by_speed = collections.defaultdict(list)
     for seq in sequences:
-        to_world = camera_to_world(root, seq)
-        tracks = collections.defaultdict(dict)  # id -> frame -> (x, y, heading)
-        path = os.path.join(root, "training", "label_02", seq + ".txt")
-        for n, line in enumerate(open(path), 1):
-            t = line.split()
-            if len(t) < 17:
-                sys.exit(f"{path}:{n}: expected 17 fields, got {len(t)}")
-            if t[2] in VEHICLES:
-                f = int(t[0])
-                p = apply(to_world(f), [float(t[13]), float(t[14]), float(t[15])])
-                tracks[int(t[1])][f] = (p[0], p[1], heading(to_world(f), float(t[16])))
-        for track in tracks.values():
+        for track in world_label_tracks(root, seq, VEHICLES).values():
             for f in track:
                 if f - HALF not in track or f + HALF not in track:
                     continue

@@ -14,7 +14,7 @@ velocity; the RMS and median of its error are printed per span S."""
 import collections, math, os, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from kitti_frames import apply, camera_to_world  # noqa: E402
+from kitti_frames import apply, camera_to_world, world_label_tracks  # noqa: E402
 
 SPANS = (1.0, 1.5, 2.0, 3.0)
 
@@ -26,12 +26,7 @@ def main():
     errors = {s: [] for s in SPANS}
     for seq in sequences:
         to_world = camera_to_world(root, seq)
-        labels = collections.defaultdict(dict)  # id -> frame -> world (x, y)
-        for line in open(os.path.join(root, "training", "label_02", seq + ".txt")):
-            t = line.split()
-            if t[2] == "Pedestrian":
-                f = int(t[0])
-                labels[int(t[1])][f] = apply(to_world(f), [float(t[13]), float(t[14]), float(t[15])])
+        labels = world_label_tracks(root, seq, ("Pedestrian",), to_world)  # id -> frame -> world (x, y, heading)
         boxes = collections.defaultdict(list)  # frame -> world (x, y)
         for n, line in enumerate(open(os.path.join(root, "detections", "pointrcnn_Pedestrian", seq + ".txt")), 1):
             t = line.strip().split(",")

@@ -8,14 +8,13 @@ labels 0.5 s before and after, its velocity is the central difference of its wor
 +-0.5 s. Printed: the RMS speed and percentiles of the walkers faster than 0.5 m/s (slower, the
 poses' 0.1-0.15 m jitter is most of the motion), which is the prior's RMS speed; and the share of
 frames below that, the pedestrians standing."""
-import collections, math, os, sys
+import math, os, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from kitti_frames import apply, camera_to_world  # noqa: E402
-from importlib import import_module
+from kitti_frames import percentile, sequences_with_poses, world_label_tracks  # noqa: E402
 
-yaw = import_module("vehicle-yaw-rates")
-HALF, SPAN = yaw.HALF, yaw.SPAN
+HALF = 5  # frames: +-0.5 s at 10 Hz
+SPAN = 2 * HALF * 0.1  # s
 WALKING = 0.5  # m/s
 
 
@@ -23,7 +22,7 @@ def main():
     if len(sys.argv) < 2:
         sys.exit(__doc__)
     root = sys.argv[1]
-    sequences = sys.argv[2:] or yaw.sequences_with_poses(root)
+    sequences = sys.argv[2:] or sequences_with_poses(root)
     if not sys.argv[2:] and "0017" not in sequences and os.path.exists(
             os.path.join(root, "training", "label_02", "0017.txt")):
         sequences.append("0017")
@@ -31,18 +30,7 @@ def main():
         sys.exit(f"{root}: no poses/SSSS.txt or training/poses/SSSS.txt")
     speeds, standing = [], 0
     for seq in sequences:
-        to_world = camera_to_world(root, seq)
-        tracks = collections.defaultdict(dict)  # id -> frame -> (x, y)
-        path = os.path.join(root, "training", "label_02", seq + ".txt")
-        for n, line in enumerate(open(path), 1):
-            t = line.split()
-            if len(t) < 17:
-                sys.exit(f"{path}:{n}: expected 17 fields, got {len(t)}")
-            if t[2] == "Pedestrian":
-                f = int(t[0])
-                p = apply(to_world(f), [float(t[13]), float(t[14]), float(t[15])])
-                tracks[int(t[1])][f] = (p[0], p[1])
-        for track in tracks.values():
+        for track in world_label_tracks(root, seq, ("Pedestrian",)).values():
             for f in track:
                 if f - HALF in track and f + HALF in track:
                     a, b = track[f - HALF], track[f + HALF]
@@ -57,8 +45,8 @@ def main():
     rms = math.sqrt(sum(s * s for s in speeds) / len(speeds))
     print(f"{len(speeds)} frames of pedestrians faster than {WALKING} m/s in {len(sequences)} sequences "
           f"({standing} slower: {100 * standing / (standing + len(speeds)):.0f} %)")
-    print(f"speed m/s: RMS {rms:.3f}, median {yaw.percentile(speeds, 0.5):.3f}, p10 {yaw.percentile(speeds, 0.1):.3f}, "
-          f"p90 {yaw.percentile(speeds, 0.9):.3f}, p99 {yaw.percentile(speeds, 0.99):.3f}")
+    print(f"speed m/s: RMS {rms:.3f}, median {percentile(speeds, 0.5):.3f}, p10 {percentile(speeds, 0.1):.3f}, "
+          f"p90 {percentile(speeds, 0.9):.3f}, p99 {percentile(speeds, 0.99):.3f}")
 
 
 if __name__ == "__main__":

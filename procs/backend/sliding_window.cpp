@@ -477,11 +477,12 @@ Eigen::Matrix3d SlidingWindow::stillVelocityCovariance(const Track& track) const
   // of its motion: the evidence's covariance plus its mean squared, the second moment about the
   // published zero. A walker whose boxes cannot yet tell it from standing is still by the test but
   // 1.3 m/s off, which a zero covariance hid from every consumer (and from dlslot-eval's NEES).
-  // With no box in the window (a landmark out of view), the speed the still test lets through.
+  // The walkers' speed prior is left out: it describes walking pedestrians, and a still track is
+  // mostly a standing one. With no box in the window (a landmark out of view), the speed the still
+  // test lets through.
   const std::optional<LineVelocity> line = boxLineVelocity(track);
   if (!line) return config_.static_max_speed * config_.static_max_speed * Eigen::Matrix3d::Identity();
-  const bool measured = !track.motions.empty() || !track.sight_speeds.empty();
-  const LineVelocity v = isVehicle(track.type) && measured ? youngVehicleVelocity(track, *line) : *line;
+  const LineVelocity v = isVehicle(track.type) ? youngVehicleVelocity(track, *line) : *line;
   return v.covariance3() + v.velocity * v.velocity.transpose();
 }
 

@@ -701,6 +701,10 @@ TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
   expectRefused("walker_line_span_s", "-1");
   EXPECT_EQ(c.walker_rms_speed, 1.5);
   for (const char* bad : {"-1", "slow"}) expectRefused("walker_rms_speed", bad);
+  EXPECT_EQ(c.side_azimuth_step_deg, 0.18);
+  for (const char* bad : {"-0.1", "10", "fine"}) expectRefused("side_azimuth_step_deg", bad);
+  EXPECT_EQ(c.side_length_tolerance, 0.5);
+  expectRefused("side_length_tolerance", "0");
   EXPECT_EQ(c.switch_min_sigmas, 3.0);
   expectRefused("switch_min_sigmas", "-1");
   EXPECT_EQ(c.vehicle_acceleration, 1.0);

@@ -69,7 +69,7 @@ TEST(LineOfSight, OnlyAFrontOrBackFacingTheSensorCounts) {
 TEST(LineOfSight, TheMedianPairAlongTheNewestLineOfSightOnly) {
   const Eigen::Vector2d u0(1, 0), u(0.8, 0.6);
   // One pair caught the bonnet instead of the bumper: 15 m/s off.
-  const std::optional<VelocityEvidence> v = lineOfSightVelocity({{u0, -24.8}, {u, -10.0}, {u, -25.1}}, 0.3);
+  const std::optional<VelocityEvidence> v = medianPairVelocity({{u0, -24.8, 0.3}, {u, -10.0, 0.3}, {u, -25.1, 0.3}});
   ASSERT_TRUE(v);
   EXPECT_TRUE(v->velocity.isApprox(-24.8 * u, 1e-12));
   // Information along u (1 / 0.3^2), none across it.
@@ -77,46 +77,38 @@ TEST(LineOfSight, TheMedianPairAlongTheNewestLineOfSightOnly) {
   const Eigen::Vector2d across(-u.y(), u.x());
   EXPECT_NEAR(across.dot(v->information * across), 0.0, 1e-12);
   // Two pairs: their mean.
-  EXPECT_TRUE(lineOfSightVelocity({{u, -24.0}, {u, -25.0}}, 0.3)->velocity.isApprox(-24.5 * u, 1e-12));
-  EXPECT_FALSE(lineOfSightVelocity({}, 0.3));
+  EXPECT_TRUE(medianPairVelocity({{u, -24.0, 0.3}, {u, -25.0, 0.3}})->velocity.isApprox(-24.5 * u, 1e-12));
+  EXPECT_FALSE(medianPairVelocity({}));
+  // The median pair's standard deviation: 0.4.
+  EXPECT_NEAR(u.dot(medianPairVelocity({{u, -24.0, 0.3}, {u, -25.0, 0.4}, {u, -24.5, 0.6}})->information * u), 1.0 / 0.16,
+              1e-9);
 }
 
 TEST(LineOfSight, AFewPointPairCountsOnlyWhereAnotherAgrees) {
   const Eigen::Vector2d u(1, 0);
-  const auto pair = [&](double speed, int points) { return SightSpeed{u, speed, 0.0, points}; };
+  const auto pair = [&](double speed, int points) { return PairSpeed{u, speed, 0.3, 0.0, points}; };
   // A car's first pairs, the second from 11 points on the bonnet: neither counts alone; before,
   // their mean was 5 m/s.
-  EXPECT_FALSE(lineOfSightVelocity({pair(-1.13, 15), pair(11.2, 11)}, 0.3, 20));
+  EXPECT_FALSE(medianPairVelocity({pair(-1.13, 15), pair(11.2, 11)}, 20));
   // Two that agree within 2 sigma count, the stray one does not (the median of the two).
-  EXPECT_TRUE(lineOfSightVelocity({pair(-1.1, 15), pair(11.2, 11), pair(-1.5, 12)}, 0.3, 20)
+  EXPECT_TRUE(medianPairVelocity({pair(-1.1, 15), pair(11.2, 11), pair(-1.5, 12)}, 20)
                   ->velocity.isApprox(-1.3 * u, 1e-12));
   // A pair of 20 points or more counts alone, and lets a few-point pair that agrees with it count.
-  EXPECT_TRUE(lineOfSightVelocity({pair(-1.2, 25)}, 0.3, 20)->velocity.isApprox(-1.2 * u, 1e-12));
-  EXPECT_TRUE(lineOfSightVelocity({pair(-1.2, 25), pair(-1.0, 12), pair(5.0, 12)}, 0.3, 20)
+  EXPECT_TRUE(medianPairVelocity({pair(-1.2, 25)}, 20)->velocity.isApprox(-1.2 * u, 1e-12));
+  EXPECT_TRUE(medianPairVelocity({pair(-1.2, 25), pair(-1.0, 12), pair(5.0, 12)}, 20)
                   ->velocity.isApprox(-1.1 * u, 1e-12));
   // Without a point threshold every pair counts, as before.
-  EXPECT_TRUE(lineOfSightVelocity({pair(-1.13, 15), pair(11.2, 11)}, 0.3)->velocity.isApprox(5.035 * u, 1e-12));
+  EXPECT_TRUE(medianPairVelocity({pair(-1.13, 15), pair(11.2, 11)})->velocity.isApprox(5.035 * u, 1e-12));
 }
 
 namespace {
-
-// A backend whose only measurement of the car's points is the line of sight: its registrations
-// are held off by a point count no car reaches.
-BackendConfig lineOfSightOnly() {
-  BackendConfig c;
-  c.compute_covariance = false;
-  c.observation_sigma_growth_per_m = 0.035;
-  c.registration_types = {"Car"};
-  c.registration.min_points = 100000;
-  return c;
-}
 
 // A young oncoming car 70 -> 55 m ahead at 25 m/s, its boxes as far off as the backend's noise
 // model says (0.105 m x (1 + 0.035 x 65 m) = 0.34 m, config/dlslot.yaml), the ego stopped: the RMS
 // error of its published velocity over its young frames, with and without the line of sight.
 double youngVelocityError(int line_of_sight_pairs) {
   const SimScene scene = oneCar(constantTwist(planarPose(70.0, 3.5, M_PI, -1.73 + 0.75), 25.0, 0.0), 0.34);
-  BackendConfig c = lineOfSightOnly();
+  BackendConfig c = registrationHeldOff();
   c.line_of_sight_pairs = line_of_sight_pairs;
   SlidingWindow window(c);
   std::mt19937 rng(5);
@@ -159,7 +151,7 @@ BrakingErrors brakingOncomingCar(bool on_chain) {
   };
   SimScene scene = oneCar([along](double t) { return planarPose(100.0 - along(t).first, 3.5, M_PI); }, 0.36);
   scene.ego = constantTwist(Pose::Identity(), 5.0, 0.0);
-  BackendConfig c = lineOfSightOnly();
+  BackendConfig c = registrationHeldOff();
   c.line_of_sight_chain = on_chain;
   SlidingWindow window(c);
   std::mt19937 rng(6);
@@ -209,7 +201,7 @@ std::vector<double> brakingOncomingErrorByFrame() {
   for (int drive = 0; drive < kDrives; ++drive) {
     SimScene scene = oneCar([along](double t) { return planarPose(55.0 - along(t).first, 3.5, M_PI); }, 0.36);
     scene.ego = constantTwist(Pose::Identity(), 5.0, 0.0);
-    SlidingWindow window(lineOfSightOnly());
+    SlidingWindow window(registrationHeldOff());
     std::mt19937 rng(100 + drive);
     for (BackendInput in : scene.generate(kFrames)) {
       scanTheCar(scene, in, rng);

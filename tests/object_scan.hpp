@@ -36,19 +36,24 @@ inline bool rayBox(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, co
 
 // Points of a box of size `size` at T_world_box seen from a sensor at `sensor` (world, 1.7 m above
 // the box floor's plane when z = 0 is the ground), range noise `noise` m. `ground`: also the
-// ground (z = floor) within `ground_margin` m of the box footprint.
+// ground (z = floor) within `ground_margin` m of the box footprint. The columns, 0.17 deg apart,
+// start at the box's first bearing; with `column_phase` in [0, 1) they lie on the lidar's grid
+// instead, shifted by that fraction of a column (a lidar's firing phase changes from scan to scan).
 inline ObjectPoints scanBox(const Pose& T_world_box, const Eigen::Vector3d& size, const Eigen::Vector3d& sensor,
-                            std::mt19937& rng, double noise = 0.01, bool ground = false, double ground_margin = 0.3) {
+                            std::mt19937& rng, double noise = 0.01, bool ground = false, double ground_margin = 0.3,
+                            double column_phase = -1.0) {
   std::normal_distribution<double> n(0.0, noise);
   const Eigen::Vector3d half = 0.5 * size;
   const Pose inv = T_world_box.inverse();
   const Eigen::Vector3d c = T_world_box.translation() - sensor;
   const double az_c = std::atan2(c.y(), c.x()), reach = std::atan2(size.head<2>().norm(), c.head<2>().norm());
   const double floor_z = T_world_box.translation().z() - half.z();
+  const double step = 0.17 * M_PI / 180.0;
+  const double first = column_phase < 0 ? az_c - reach : (std::floor((az_c - reach) / step) + column_phase) * step;
   ObjectPoints out;
   for (int beam = 0; beam < 64; ++beam) {
     const double el = (2.0 - beam * 26.9 / 63.0) * M_PI / 180.0;
-    for (double az = az_c - reach; az <= az_c + reach; az += 0.17 * M_PI / 180.0) {
+    for (double az = first; az <= az_c + reach; az += step) {
       const Eigen::Vector3d dir(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
       double hit;
       const bool on_box = rayBox(inv * sensor, inv.linear() * dir, half, &hit);

@@ -7,6 +7,7 @@
 #include <random>
 #include <utility>
 
+#include "backend/backend_config.hpp"
 #include "backend_scene.hpp"
 #include "object_scan.hpp"
 
@@ -27,11 +28,25 @@ inline SimScene oneCar(std::function<Pose(double)> pose, double box_noise) {
   return scene;
 }
 
-// The car's points in this frame's scan (lidar frame), given to its observation.
-inline void scanTheCar(const SimScene& scene, BackendInput& in, std::mt19937& rng) {
+// The car's points in this frame's scan (lidar frame), given to its observation; column_phase as
+// scanBox's.
+inline void scanTheCar(const SimScene& scene, BackendInput& in, std::mt19937& rng, double column_phase = -1.0) {
   const Pose car_in_lidar = scene.egoTruth(in.frame).inverse() * scene.objectTruth(1, in.frame);
   for (ObservationInput& o : in.observations)
-    o.points = std::make_shared<const ObjectPoints>(scanBox(car_in_lidar, kCar, Eigen::Vector3d::Zero(), rng));
+    o.points = std::make_shared<const ObjectPoints>(
+        scanBox(car_in_lidar, kCar, Eigen::Vector3d::Zero(), rng, 0.01, false, 0.3, column_phase));
+}
+
+// A backend whose registrations are held off by a point count no car reaches: what else a car's
+// points measure (the line of sight, the side's ends), its boxes' noise growing with range as
+// config/dlslot.yaml's.
+inline BackendConfig registrationHeldOff() {
+  BackendConfig c;
+  c.compute_covariance = false;
+  c.observation_sigma_growth_per_m = 0.035;
+  c.registration_types = {"Car"};
+  c.registration.min_points = 100000;
+  return c;
 }
 
 }  // namespace dlslot::backend::test

@@ -169,6 +169,11 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   s.get("line_of_sight_sigma", c.line_of_sight_sigma);
   require(c.line_of_sight_sigma > 0.0, s, "line_of_sight_sigma", "a speed > 0 (m/s)");
   s.get("line_of_sight_chain", c.line_of_sight_chain);
+  s.get("side_azimuth_step_deg", c.side_azimuth_step_deg);
+  require(c.side_azimuth_step_deg >= 0.0 && c.side_azimuth_step_deg < 10.0, s, "side_azimuth_step_deg",
+          "an angle in [0, 10) (deg; 0: not used)");
+  s.get("side_length_tolerance", c.side_length_tolerance);
+  require(c.side_length_tolerance > 0.0, s, "side_length_tolerance", "a distance > 0 (m)");
   s.get("face_heading", c.face_heading);
   s.get("registration_ground_clearance", c.registration_ground_clearance);
   require(c.registration_ground_clearance >= 0.0, s, "registration_ground_clearance", "a distance >= 0 (m)");

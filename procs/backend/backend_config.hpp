@@ -102,7 +102,7 @@ struct BackendConfig {
   // pairs, 0.24-0.39). line_of_sight_pairs 0: not used.
   int line_of_sight_min_points = 20;
   // The young path also takes pairs of this many points or more, each only where another pair
-  // agrees with it (lineOfSightVelocity); the chain only those of line_of_sight_min_points.
+  // agrees with it (medianPairVelocity); the chain only those of line_of_sight_min_points.
   int line_of_sight_young_min_points = 10;
   double line_of_sight_max_angle_deg = 10.0;  // the box's heading from the line of sight (facesTheSensor)
   int line_of_sight_pairs = 3;
@@ -110,6 +110,13 @@ struct BackendConfig {
   // Each pair also a factor on a vehicle's chain once it spans the window, for the frames no
   // registration measured (sight_speed_factor.hpp).
   bool line_of_sight_chain = true;
+  // A vehicle that shows its side: its speed along its heading from the side's ends (side_ends.hpp),
+  // a young one's from the line through its window's side scans, its chain's from each scan pair
+  // (as the line of sight's: line_of_sight_min_points, line_of_sight_chain). side_azimuth_step_deg
+  // is the lidar's column spacing (0: not used); a scan counts only where its ends lie within
+  // side_length_tolerance (m) of the vehicle's mean box length.
+  double side_azimuth_step_deg = 0.0;
+  double side_length_tolerance = 0.5;
   // A registering vehicle's heading from the faces its points show, each scan a factor on its
   // pose (face_heading.hpp).
   bool face_heading = true;

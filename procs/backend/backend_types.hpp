@@ -102,6 +102,8 @@ struct BackendOutput {
   // Scan pairs of this frame whose face's speed along the line of sight was measured
   // (line_of_sight.hpp).
   int line_of_sight_pairs = 0;
+  // And those whose side's ends gave its speed along its heading (side_ends.hpp).
+  int side_pairs = 0;
 };
 
 }  // namespace dlslot::backend

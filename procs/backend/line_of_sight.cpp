@@ -34,24 +34,4 @@ std::optional<Eigen::Vector3d> lineOfSight(const ObjectPoints& points, const Eig
   return u.normalized();
 }
 
-std::optional<VelocityEvidence> lineOfSightVelocity(const std::vector<SightSpeed>& pairs, double sigma_mps,
-                                                    int trusted_points) {
-  if (!(sigma_mps > 0)) return std::nullopt;
-  const double agree = 2.0 * std::sqrt(2.0) * sigma_mps;
-  std::vector<double> speeds;
-  const SightSpeed* newest = nullptr;
-  for (const SightSpeed& p : pairs) {
-    const auto agrees = [&](const SightSpeed& q) { return &q != &p && std::abs(q.speed - p.speed) <= agree; };
-    if (p.points < trusted_points && std::none_of(pairs.begin(), pairs.end(), agrees)) continue;
-    speeds.push_back(p.speed);
-    newest = &p;
-  }
-  if (!newest) return std::nullopt;
-  const Eigen::Vector2d u = newest->u;
-  VelocityEvidence v;
-  v.velocity = median(speeds) * u;
-  v.information = u * u.transpose() / (sigma_mps * sigma_mps);
-  return v;
-}
-
 }  // namespace dlslot::backend

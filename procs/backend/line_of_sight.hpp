@@ -9,7 +9,8 @@
 // registration, against the true velocity), pairs with 20+ points in both scans: 0.24-0.39 m/s
 // RMS among those within 1 m/s, but 13-31 % beyond it (a ring crossing from bumper to bonnet, a
 // neighbour's points in the box); below 20 points, half of them beyond it. Hence the median over
-// the last few pairs, and a test against the boxes' line before it is used (fuseVelocities).
+// the last few pairs (medianPairVelocity), and a test against the boxes' line before it is used
+// (fuseVelocities).
 #pragma once
 
 #include <Eigen/Core>
@@ -17,7 +18,7 @@
 #include <vector>
 
 #include "backend/object_registration.hpp"
-#include "backend/registered_velocity.hpp"
+#include "backend/pair_speed.hpp"
 #include "dlslot/types.hpp"
 
 namespace dlslot::backend {
@@ -39,25 +40,5 @@ bool facesTheSensor(const Box& box, double max_angle_deg);
 // The horizontal unit direction from the sensor to the points' centroid (world); nothing when they
 // are (nearly) above it.
 std::optional<Eigen::Vector3d> lineOfSight(const ObjectPoints& points, const Eigen::Vector3d& sensor);
-
-// One scan pair's speed (m/s) along u: the face's range in the current scan along the previous
-// scan's line of sight, minus the previous one, over the time between them.
-struct SightSpeed {
-  Eigen::Vector2d u = Eigen::Vector2d::UnitX();
-  double speed = 0;
-  // The sensor's displacement along u between the two scans (m) in the ego poses the pair was
-  // measured with: speed x dt minus it is the face's motion against the sensor (sight_speed_factor.hpp).
-  double sensor_displacement = 0;
-  int points = 0;  // the fewer of the two scans' points
-};
-
-// The median of the counted pairs' speeds as a velocity measured along the newest counted pair's u
-// alone, with standard deviation sigma_mps there and no information across it. A pair of fewer
-// than trusted_points points counts only when another pair agrees with it, within two standard
-// deviations of the difference of two good pairs (2 sqrt(2) sigma_mps): below 20 points 38 % of
-// the pairs are over 1 m/s off, and two such pairs rarely agree (the median of two pairs is their
-// mean, so one stray pair took a car's first velocity 6 m/s off). Nothing without pairs that count.
-std::optional<VelocityEvidence> lineOfSightVelocity(const std::vector<SightSpeed>& pairs, double sigma_mps,
-                                                    int trusted_points = 0);
 
 }  // namespace dlslot::backend

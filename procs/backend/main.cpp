@@ -97,6 +97,7 @@ void report(ProcessStatus& status, const BackendOutput& out) {
       status.count(std::string("registration_") + toString(static_cast<RegistrationOutcome>(k)), out.registrations[k]);
   if (out.registration_no_previous) status.count("registration_no_previous", out.registration_no_previous);
   if (out.line_of_sight_pairs) status.count("line_of_sight_pairs", out.line_of_sight_pairs);
+  if (out.side_pairs) status.count("side_pairs", out.side_pairs);
   // The odometry factor's test (odometry_consistency.hpp): frames tested, and those where the
   // landmarks and objects disagreed with it beyond both covariances (down-weighted or reported).
   const OdometryCheck& c = out.odometry_check;
@@ -168,7 +169,7 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   int frames = 0, missing_odometry = 0, missing_associations = 0;
   int64_t landmarks = 0, moving = 0, switched = 0;  // summed over frames
   std::array<int64_t, kNumRegistrationOutcomes> registrations{};
-  int64_t registration_no_previous = 0, registration_points = 0, line_of_sight_pairs = 0;
+  int64_t registration_no_previous = 0, registration_points = 0, line_of_sight_pairs = 0, side_pairs = 0;
   double registration_residual_sq = 0;
   int odometry_tested = 0, odometry_disagreed = 0, odometry_downweighted = 0;
   double odometry_max_disagreement_m = 0;
@@ -192,6 +193,7 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
     registration_points += result.registration_points;
     registration_residual_sq += result.registration_residual_sq;
     line_of_sight_pairs += result.line_of_sight_pairs;
+    side_pairs += result.side_pairs;
     const OdometryCheck& check = result.odometry_check;
     odometry_tested += check.outcome != OdometryCheckOutcome::kUntested;
     if (check.outcome != OdometryCheckOutcome::kUntested) odometry_chi2.push_back(check.chi2);
@@ -258,8 +260,9 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   std::printf("  per-object registrations:");
   for (int k = 0; k < kNumRegistrationOutcomes; ++k)
     std::printf(" %s %lld", toString(static_cast<RegistrationOutcome>(k)), static_cast<long long>(registrations[k]));
-  std::printf(", no previous scan %lld; line-of-sight pairs %lld\n", static_cast<long long>(registration_no_previous),
-              static_cast<long long>(line_of_sight_pairs));
+  std::printf(", no previous scan %lld; line-of-sight pairs %lld, side pairs %lld\n",
+              static_cast<long long>(registration_no_previous), static_cast<long long>(line_of_sight_pairs),
+              static_cast<long long>(side_pairs));
   std::sort(odometry_chi2.begin(), odometry_chi2.end());
   const auto chi2At = [&](double q) {
     return odometry_chi2.empty() ? 0.0 : odometry_chi2[static_cast<size_t>(q * (odometry_chi2.size() - 1))];

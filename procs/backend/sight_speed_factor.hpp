@@ -10,6 +10,8 @@
 // would bring the odometry's motion into the window once more for every such vehicle.
 // The face's own turn (a yaw rate times its half length) is left out: the face is within 10 deg
 // of head-on and a vehicle turning hard enough to matter shows its side.
+// The same factor takes a side's ends' speed along the vehicle's heading (side_ends.hpp), u then
+// the heading: the ends' middle is the body's centre along it, which a turn does not move.
 #pragma once
 
 #include "backend/pose_factor.hpp"

@@ -286,8 +286,10 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
   }
   // The young path reads it (youngVehicleVelocity); a chain takes each pair as a factor when
   // line_of_sight_chain is set, and needs none otherwise.
-  if (!track.velocity_from_chain || config_.line_of_sight_chain)
+  if (!track.velocity_from_chain || config_.line_of_sight_chain) {
     out.line_of_sight_pairs += measureLineOfSight(track, world, obs.box, frame, X, frame_dt);
+    out.side_pairs += measureSideEnds(track, world, obs.box, frame, X);
+  }
   const std::shared_ptr<const PreparedObject> previous = track.points;
   const int previous_frame = track.points_frame;
   const double range = obs.box.center.norm();
@@ -350,15 +352,65 @@ bool SlidingWindow::measureLineOfSight(Track& track, const ObjectPoints& world, 
   bool paired = false;
   if (track.sight && track.sight->frame == frame - 1 && dt > 0)
     if (const std::optional<double> range = nearFaceRange(world, track.sight->u)) {
-      track.sight_speeds[frame] = SightSpeed{track.sight->u.head<2>(), (*range - track.sight->range) / dt,
-                                             track.sight->u.dot(X.translation() - track.sight->sensor),
-                                             std::min(track.sight->points, static_cast<int>(world.size()))};
+      track.sight_speeds[frame] = PairSpeed{track.sight->u.head<2>(), (*range - track.sight->range) / dt,
+                                            config_.line_of_sight_sigma,
+                                            track.sight->u.dot(X.translation() - track.sight->sensor),
+                                            std::min(track.sight->points, static_cast<int>(world.size()))};
       paired = true;
     }
   track.sight.reset();
   if (const std::optional<Eigen::Vector3d> u = lineOfSight(world, X.translation()))
     track.sight = Track::SightFace{frame, *u, *nearFaceRange(world, *u), static_cast<int>(world.size()), X.translation()};
   return paired;
+}
+
+bool SlidingWindow::measureSideEnds(Track& track, const ObjectPoints& world, const Box& box, int frame,
+                                   const Pose& X) const {
+  const Eigen::Vector2d c = box.center.head<2>();
+  if (config_.side_azimuth_step_deg <= 0 || config_.line_of_sight_pairs <= 0 || c.norm() < 1e-3 ||
+      static_cast<int>(world.size()) < config_.line_of_sight_young_min_points ||
+      facesTheSensor(box, config_.line_of_sight_max_angle_deg))
+    return false;
+  // The angle between the side and the line of sight widens the columns' spacing along it.
+  const double sin_angle = std::abs(std::cos(box.yaw) * c.y() - std::sin(box.yaw) * c.x()) / c.norm();
+  const double yaw = box.yaw + yawOf(X.linear());
+  track.side_scans[frame] = Track::SideScanPoints{
+      std::make_shared<const ObjectPoints>(world), Eigen::Vector3d(std::cos(yaw), std::sin(yaw), 0.0),
+      sideEndSigma(c.norm(), sin_angle, config_.side_azimuth_step_deg * M_PI / 180.0, config_.registration.accuracy_m),
+      X.translation()};
+  return sidePair(track, frame - 1, frame).has_value();
+}
+
+std::optional<PairSpeed> SlidingWindow::sidePair(const Track& track, int f0, int f1) const {
+  const auto previous = track.side_scans.find(f0), current = track.side_scans.find(f1);
+  if (previous == track.side_scans.end() || current == track.side_scans.end()) return std::nullopt;
+  const Track::SideScanPoints &a = previous->second, &b = current->second;
+  const std::optional<SideEnds> ends_a = sideEnds(*a.points, a.d), ends_b = sideEnds(*b.points, a.d);
+  if (!ends_a || !ends_b) return std::nullopt;
+  std::optional<PairSpeed> p = sidePairSpeed(SideView{*ends_a, a.end_sigma}, SideView{*ends_b, b.end_sigma}, a.d.head<2>(),
+                                             track.size.x(), config_.side_length_tolerance, secondsBetween(f0, f1));
+  if (!p) return std::nullopt;
+  p->sensor_displacement = a.d.dot(b.sensor - a.sensor);
+  p->points = static_cast<int>(std::min(a.points->size(), b.points->size()));
+  return p;
+}
+
+std::optional<VelocityEvidence> SlidingWindow::sideVelocity(const Track& track) const {
+  if (track.side_scans.size() < 2) return std::nullopt;
+  const Eigen::Vector3d& d = track.side_scans.rbegin()->second.d;
+  std::vector<SideScan> scans;
+  for (const auto& [f, scan] : track.side_scans)
+    if (const EgoFrame* ego = findFrame(f))
+      if (const std::optional<SideEnds> ends = sideEnds(*scan.points, d))
+        scans.push_back(SideScan{1e-6 * static_cast<double>(ego->utime), SideView{*ends, scan.end_sigma}});
+  const std::optional<SideLine> line = sideLine(scans, track.size.x(), config_.side_length_tolerance);
+  if (!line) return std::nullopt;
+  const double age = 1e-6 * static_cast<double>(frames_.back().utime) - line->time;
+  const double variance = line->sigma * line->sigma + std::pow(config_.vehicle_acceleration * age, 2);
+  VelocityEvidence v;
+  v.velocity = line->speed * d.head<2>();
+  v.information = d.head<2>() * d.head<2>().transpose() / variance;
+  return v;
 }
 
 std::optional<SpeedFit> SlidingWindow::windowMotion(const Track& track,
@@ -451,14 +503,17 @@ std::vector<VelocityEvidence> SlidingWindow::pointsVelocities(const Track& track
                                           config_.vehicle_acceleration * age))
       measured.push_back(*v);
   }
-  if (!measured.empty()) return measured;
   // Far away: the face's speed along the line of sight over the last pairs, if any.
-  const int t = frames_.back().frame;
-  std::vector<SightSpeed> pairs;
-  const auto first = track.sight_speeds.lower_bound(t - config_.line_of_sight_pairs + 1);
-  for (auto it = first; it != track.sight_speeds.end(); ++it) pairs.push_back(it->second);
-  if (const auto sight = lineOfSightVelocity(pairs, config_.line_of_sight_sigma, config_.line_of_sight_min_points))
-    measured.push_back(*sight);
+  if (measured.empty()) {
+    const int t = frames_.back().frame;
+    std::vector<PairSpeed> pairs;
+    for (auto it = track.sight_speeds.lower_bound(t - config_.line_of_sight_pairs + 1); it != track.sight_speeds.end(); ++it)
+      pairs.push_back(it->second);
+    if (const auto sight = medianPairVelocity(pairs, config_.line_of_sight_min_points)) measured.push_back(*sight);
+  }
+  // The side's ends measure the motion along the heading, which a side's registration cannot
+  // (partial or degenerate): beside the registrations, as independent evidence.
+  if (const std::optional<VelocityEvidence> side = sideVelocity(track)) measured.push_back(*side);
   return measured;
 }
 
@@ -504,7 +559,8 @@ void SlidingWindow::startTrack(Track& track, int frame) {
   // fused with its boxes' line bounds its speed far more tightly than 3-4 boxes do. Queues' vans
   // and trucks creeping at 1-3 m/s were started static by their boxes and published still for
   // their first 2-9 frames (highway-jam seeds 1, 2 and 7).
-  if (!dynamic && isVehicle(track.type) && (!track.motions.empty() || !track.sight_speeds.empty()))
+  if (!dynamic && isVehicle(track.type) &&
+      (!track.motions.empty() || !track.sight_speeds.empty() || !track.side_scans.empty()))
     if (const std::optional<LineVelocity> line = boxLineVelocity(track)) {
       const LineVelocity v = youngVehicleVelocity(track, *line);
       dynamic = movesBeyond(v.velocity.head<2>(), v.covariance, config_.static_max_speed, config_.dynamic_min_sigmas);
@@ -564,9 +620,8 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
           registrationMeasurement(m->second.M, m->second.information, m->second.X_prev, m->second.X_cur);
       addFactor(RegistrationFactor::Create(rm.A_meas, rm.sqrt_info), true,
                 {ego_prev->pose->data(), ego_cur->pose->data(), prev, change});
-    } else if (track.sight_on_chain) {
-      addSightSpeedFactor(track, f);
     }
+    if (track.sight_on_chain) addPairSpeedFactors(track, f);
     auto before = track.changes.find(f - 2);
     if (before != track.changes.end())
       addFactor(ConstantVelocityFactor::Create(sqrtInformation(constantVelocitySigma(track, f, displacement))), false,
@@ -585,26 +640,29 @@ void SlidingWindow::extendChain(Track& track, int frame, const Pose& o) {
   if (config_.line_of_sight_chain && !track.sight_on_chain &&
       static_cast<int>(track.changes.size()) >= config_.window_size - 1) {
     track.sight_on_chain = true;
-    for (const auto& [g, c] : track.changes)
-      if (!track.motions.count(g + 1)) addSightSpeedFactor(track, g + 1);
+    for (const auto& [g, c] : track.changes) addPairSpeedFactors(track, g + 1);
   }
 }
 
-void SlidingWindow::addSightSpeedFactor(const Track& track, int f) {
-  // The face's speed along the line of sight between f - 1 and f where no registration measured
-  // the motion (robust: 13-31 % of the pairs are over 1 m/s off, line_of_sight.hpp).
-  const auto sight = track.sight_speeds.find(f);
+void SlidingWindow::addPairSpeedFactors(const Track& track, int f) {
+  // The pairs' speeds between f - 1 and f (robust: 13-31 % of the line-of-sight pairs are over
+  // 1 m/s off, line_of_sight.hpp): the face's along the line of sight where no registration
+  // measured the motion, the side's ends' along the heading, which a side's registration does not
+  // measure (side_ends.hpp).
   const EgoFrame *ego_prev = findFrame(f - 1), *ego_cur = findFrame(f);
   const auto pose = track.poses.find(f - 1);
   const auto change = track.changes.find(f - 1);
-  if (sight == track.sight_speeds.end() || sight->second.points < config_.line_of_sight_min_points || !ego_prev ||
-      !ego_cur || pose == track.poses.end() || change == track.changes.end())
-    return;
+  if (!ego_prev || !ego_cur || pose == track.poses.end() || change == track.changes.end()) return;
   const double dt = secondsBetween(f - 1, f);
-  const SightSpeed& s = sight->second;
-  addFactor(SightSpeedFactor::Create(Eigen::Vector3d(s.u.x(), s.u.y(), 0.0), s.speed * dt - s.sensor_displacement,
-                                     config_.line_of_sight_sigma * dt),
-            true, {ego_prev->pose->data(), ego_cur->pose->data(), pose->second->data(), change->second->data()});
+  const auto add = [&](const PairSpeed& s) {
+    if (s.points < config_.line_of_sight_min_points) return;
+    addFactor(SightSpeedFactor::Create(Eigen::Vector3d(s.u.x(), s.u.y(), 0.0), s.speed * dt - s.sensor_displacement,
+                                       s.sigma * dt),
+              true, {ego_prev->pose->data(), ego_cur->pose->data(), pose->second->data(), change->second->data()});
+  };
+  if (const auto sight = track.sight_speeds.find(f); sight != track.sight_speeds.end() && !track.motions.count(f))
+    add(sight->second);
+  if (const std::optional<PairSpeed> side = sidePair(track, f - 1, f)) add(*side);
 }
 
 void SlidingWindow::startStraight(const Track& track, int f, double* change, const Eigen::Vector3d& displacement) {
@@ -919,6 +977,7 @@ SmoothedPose SlidingWindow::slide() {
     track.observations.erase(track.observations.begin(), track.observations.upper_bound(s));
     track.motions.erase(track.motions.begin(), track.motions.upper_bound(s));
     track.sight_speeds.erase(track.sight_speeds.begin(), track.sight_speeds.upper_bound(s));
+    track.side_scans.erase(track.side_scans.begin(), track.side_scans.upper_bound(s));
     track.face_headings.erase(track.face_headings.begin(), track.face_headings.upper_bound(s));
   }
   for (Track* track : left_view) {

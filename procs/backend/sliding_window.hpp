@@ -27,6 +27,7 @@
 #include "backend/object_model.hpp"
 #include "backend/pose_manifold.hpp"
 #include "backend/registered_velocity.hpp"
+#include "backend/side_ends.hpp"
 #include "backend/track_front.hpp"
 #include "backend/window_solver.hpp"
 
@@ -111,7 +112,17 @@ class SlidingWindow {
       Eigen::Vector3d sensor = Eigen::Vector3d::Zero();  // the ego position its points were put in the world with
     };
     std::optional<SightFace> sight;
-    std::map<int, SightSpeed> sight_speeds;
+    std::map<int, PairSpeed> sight_speeds;
+    // The scans whose box showed its side: its points (world), the box's heading d (world), one
+    // end's standard deviation and the ego position the points were put in the world with
+    // (side_ends.hpp).
+    struct SideScanPoints {
+      std::shared_ptr<const ObjectPoints> points;
+      Eigen::Vector3d d = Eigen::Vector3d::UnitX();
+      double end_sigma = 0;
+      Eigen::Vector3d sensor = Eigen::Vector3d::Zero();
+    };
+    std::map<int, SideScanPoints> side_scans;
     // A vehicle's heading from its faces' points, per scan (face_heading.hpp; yaw in the scan's axes).
     std::map<int, FaceHeading> face_headings;
     Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
@@ -131,6 +142,16 @@ class SlidingWindow {
   // before had one, the pair's speed along it (line_of_sight.hpp); true when it measured a pair.
   bool measureLineOfSight(Track& track, const ObjectPoints& world, const Box& box, int frame, const Pose& X,
                           double dt) const;
+  // This scan's points when its box shows the side (side_ends.hpp); true when the scan before did
+  // too and the pair counts.
+  bool measureSideEnds(Track& track, const ObjectPoints& world, const Box& box, int frame, const Pose& X) const;
+  // The side's ends' speed along the heading of scan f0 over f0 -> f1, if both show the side and
+  // the pair counts (sidePairSpeed).
+  std::optional<PairSpeed> sidePair(const Track& track, int f0, int f1) const;
+  // The line through the middles of the window's side scans along the newest one's heading
+  // (sideLine), as a velocity at the newest frame: its variance grown by vehicle_acceleration over
+  // the time from the scans' mean.
+  std::optional<VelocityEvidence> sideVelocity(const Track& track) const;
   // The velocity of the line through the track's boxes in the window (windowMotion), for a
   // vehicle turned toward the mean heading of its boxes (velocityAlongHeading): a young
   // vehicle's, and a pedestrian's at every age.
@@ -168,9 +189,10 @@ class SlidingWindow {
   std::optional<SpeedFit> windowMotion(const Track& track, const std::optional<WindowHeading>& heading) const;
   void addTrackObservation(Track& track, int frame);
   void extendChain(Track& track, int frame, const Pose& o);
-  // The face's speed along the line of sight over f - 1 -> f as a factor on the chain, when the
-  // track has one of enough points and its poses and the ego's for both frames are in the window.
-  void addSightSpeedFactor(const Track& track, int f);
+  // The pairs' speeds over f - 1 -> f (the face's along the line of sight, the side's ends' along
+  // the heading) as factors on the chain, those of enough points, when its poses and the ego's
+  // for both frames are in the window.
+  void addPairSpeedFactors(const Track& track, int f);
   // The prior that starts a vehicle's chain straight on its first pose change c_{f-1}^f, which
   // moved it by `displacement` (world), at the track's speed (vehicle_motion_factor.hpp).
   void startStraight(const Track& track, int f, double* change, const Eigen::Vector3d& displacement);

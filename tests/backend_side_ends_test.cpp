@@ -95,6 +95,8 @@ TEST(SideEnds, APairIsRefusedWhenAnEndIsHiddenOrANeighboursPointsJoin) {
   for (const Eigen::Vector3f& p : crossingCar(-4.0, 0.7, rng)) joined_b.push_back(p);
   EXPECT_FALSE(sidePairSpeed(SideView{*sideEnds(joined_a, d), sigma_end}, SideView{*sideEnds(joined_b, d), sigma_end},
                              d.head<2>(), kCar.x(), 0.5, 0.1));
+  // A view without a finite sigma counts for nothing.
+  EXPECT_FALSE(sidePairSpeed(a, SideView{b.ends, std::nan("")}, d.head<2>(), kCar.x(), 0.5, 0.1));
 }
 
 TEST(SideEnds, TheLineThroughTheMiddlesTakesEachScanOnce) {
@@ -122,8 +124,9 @@ TEST(SideEnds, TheLineThroughTheMiddlesTakesEachScanOnce) {
   ASSERT_TRUE(line);
   EXPECT_EQ(line->scans, 4);
   EXPECT_NEAR(line->speed, 10.0 - 0.04, 1e-9);
-  // One scan is no line.
+  // One scan is no line; nor one and a scan without a finite sigma.
   EXPECT_FALSE(sideLine({scans.front()}, 4.5, 0.5));
+  EXPECT_FALSE(sideLine({scans[0], SideScan{0.1, SideView{scans[1].view.ends, std::nan("")}}}, 4.5, 0.5));
 }
 
 namespace {

@@ -36,6 +36,7 @@ std::optional<PairSpeed> sidePairSpeed(const SideView& previous, const SideView&
   p.u = d;
   p.speed = (current.ends.middle() - previous.ends.middle()) / dt;
   p.sigma = std::sqrt(v0 + v1) / dt;
+  if (!std::isfinite(p.speed) || !(p.sigma > 0) || !std::isfinite(p.sigma)) return std::nullopt;
   return p;
 }
 
@@ -87,7 +88,8 @@ std::optional<SideLine> sideLine(const std::vector<SideScan>& scans, double vehi
   for (const SideScan& s : scans) {
     const double l = s.view.ends.length();
     // A length is the difference of two ends (variance 2 s^2), two lengths' difference 4 s^2.
-    if (std::abs(l - vehicle_length) <= length_tolerance && std::abs(l - median_length) <= 3.0 * 2.0 * s.view.end_sigma)
+    if (s.view.end_sigma > 0 && std::abs(l - vehicle_length) <= length_tolerance &&
+        std::abs(l - median_length) <= 3.0 * 2.0 * s.view.end_sigma)
       kept.push_back(&s);
   }
   // Each middle against the line through the others (a stray middle at either end of the run

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 #include <optional>
+#include <vector>
 
 #include "backend/object_registration.hpp"
 #include "backend/pair_speed.hpp"
@@ -62,7 +63,8 @@ struct SideScan {
 // The line through the scans' middles, weighted least squares (a middle's variance s^2 / 2): its
 // slope (m/s along d), the slope's standard deviation, and the scans' weighted mean time, where
 // the slope holds best. Unlike a run of pairs, it takes each scan once: three scans 0.1 s apart
-// give the speed to 0.7 s / 0.1 s, the median of their two pairs claims 2 s / 0.1 s (sidePairSpeed).
+// give the speed to s / 0.2 s (s: one end's sigma), where the median of their two pairs claims
+// sqrt(2) s / 0.1 s (sidePairSpeed), 2.8 times that.
 // A scan counts when its length is within length_tolerance of the vehicle's and within three
 // standard deviations of the median scan's (an end hidden or a stray point in that scan); then, of
 // four scans or more, the one whose middle is furthest from the line through the others, beyond

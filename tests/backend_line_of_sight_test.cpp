@@ -110,21 +110,10 @@ double youngVelocityError(int line_of_sight_pairs) {
   const SimScene scene = oneCar(constantTwist(planarPose(70.0, 3.5, M_PI, -1.73 + 0.75), 25.0, 0.0), 0.34);
   BackendConfig c = registrationHeldOff();
   c.line_of_sight_pairs = line_of_sight_pairs;
-  SlidingWindow window(c);
-  std::mt19937 rng(5);
-  double sq = 0;
-  int n = 0;
-  for (BackendInput in : scene.generate(7)) {
-    scanTheCar(scene, in, rng);
-    const BackendOutput out = window.process(in);
-    for (const TrackEstimate& e : out.tracks) {
-      if (in.frame < 4) continue;  // two scan pairs at least
-      sq += (e.velocity.head<2>() - Eigen::Vector2d(-25.0, 0.0)).squaredNorm();
-      ++n;
-    }
-  }
-  EXPECT_GE(n, 3);
-  return std::sqrt(sq / std::max(n, 1));
+  // From frame 4 on: two scan pairs at least.
+  const VelocityErrors e = publishedVelocityErrors(scene, c, 7, 4, Eigen::Vector2d(-25.0, 0.0), 5);
+  EXPECT_GE(e.count, 3);
+  return e.rmse;
 }
 
 }  // namespace

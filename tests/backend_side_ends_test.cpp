@@ -138,22 +138,10 @@ double youngCrossingError(double side_azimuth_step_deg) {
   const SimScene scene = oneCar(constantTwist(planarPose(50.0, -4.0, M_PI / 2, -1.73 + 0.75), 10.0, 0.0), 0.29);
   BackendConfig c = registrationHeldOff();
   c.side_azimuth_step_deg = side_azimuth_step_deg;
-  SlidingWindow window(c);
-  std::mt19937 rng(13);
-  std::uniform_real_distribution<double> phase(0.0, 1.0);
-  double sq = 0;
-  int n = 0;
-  for (BackendInput in : scene.generate(9)) {
-    scanTheCar(scene, in, rng, phase(rng));
-    const BackendOutput out = window.process(in);
-    if (in.frame < 4) continue;  // three boxes at least
-    for (const TrackEstimate& e : out.tracks) {
-      sq += (e.velocity.head<2>() - Eigen::Vector2d(0.0, 10.0)).squaredNorm();
-      ++n;
-    }
-  }
-  EXPECT_GE(n, 4);
-  return std::sqrt(sq / std::max(n, 1));
+  // From frame 4 on: three boxes at least.
+  const VelocityErrors e = publishedVelocityErrors(scene, c, 9, 4, Eigen::Vector2d(0.0, 10.0), 13, true);
+  EXPECT_GE(e.count, 4);
+  return e.rmse;
 }
 
 }  // namespace

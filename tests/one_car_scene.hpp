@@ -2,12 +2,15 @@
 // (object_scan.hpp): for the backend tests of what a vehicle's own points measure.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <random>
 #include <utility>
 
 #include "backend/backend_config.hpp"
+#include "backend/sliding_window.hpp"
 #include "backend_scene.hpp"
 #include "object_scan.hpp"
 
@@ -35,6 +38,33 @@ inline void scanTheCar(const SimScene& scene, BackendInput& in, std::mt19937& rn
   for (ObservationInput& o : in.observations)
     o.points = std::make_shared<const ObjectPoints>(
         scanBox(car_in_lidar, kCar, Eigen::Vector3d::Zero(), rng, 0.01, false, 0.3, column_phase));
+}
+
+// The car's published velocities against `truth` (world x-y) from frame first_frame on, over the
+// scene's first `frames` frames, its points scanned each frame (with the columns shifted anew each
+// scan when shift_columns, as a lidar's firing phase does): their RMS error and how many there were.
+struct VelocityErrors {
+  double rmse = 0;
+  int count = 0;
+};
+inline VelocityErrors publishedVelocityErrors(const SimScene& scene, const BackendConfig& config, int frames,
+                                              int first_frame, const Eigen::Vector2d& truth, unsigned seed,
+                                              bool shift_columns = false) {
+  SlidingWindow window(config);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> phase(0.0, 1.0);
+  double sq = 0;
+  int n = 0;
+  for (BackendInput in : scene.generate(frames)) {
+    scanTheCar(scene, in, rng, shift_columns ? phase(rng) : -1.0);
+    const BackendOutput out = window.process(in);
+    if (in.frame < first_frame) continue;
+    for (const TrackEstimate& e : out.tracks) {
+      sq += (e.velocity.head<2>() - truth).squaredNorm();
+      ++n;
+    }
+  }
+  return {std::sqrt(sq / std::max(n, 1)), n};
 }
 
 // A backend whose registrations are held off by a point count no car reaches: what else a car's

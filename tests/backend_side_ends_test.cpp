@@ -1,9 +1,11 @@
 // A vehicle's speed along its heading from the ends of the side it shows (side_ends.hpp): the ends
 // and their standard deviation, a crossing car's speed from scan to scan against the truth on a
 // lidar whose columns fall anew each scan, the pairs refused when an end is hidden or a
-// neighbour's points join, and a young crossing car's published velocity with and without them.
+// neighbour's points join, a young crossing car's published velocity with and without them, and
+// a side cut short: which end something nearer hides, and the pairs and line of the end it saw.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -151,4 +153,141 @@ TEST(SideEnds, AYoungCrossingCarsVelocityFromItsSidesEnds) {
   std::printf("young crossing car 50 m: velocity RMSE %.3f m/s with its side's ends, %.3f without\n", with, without);
   EXPECT_LT(with, 0.2);
   EXPECT_LT(with, 0.3 * without);
+}
+
+namespace {
+
+// The side of a car 4.5 m long, its heading +y, square on 50 m ahead (its near face at x = 49.1):
+// four rings (elevations -1.2 .. 0 deg) at the 0.18 deg columns, with a wall 80 m away behind it
+// and, where `hidden_from` is below the car's front, something 30 m away hiding it from there on.
+const double kStep18 = 0.18 * M_PI / 180.0;
+struct SideScene {
+  PointCloud scan;
+  ObjectPoints car;
+};
+SideScene sideScene(double hidden_from = 10.0, bool ground = false) {
+  std::vector<Eigen::Vector4f> columns;
+  const auto add = [&](double range_x, double a, double e) {
+    columns.emplace_back(range_x, range_x * std::tan(a), std::hypot(range_x, range_x * std::tan(a)) * std::tan(e), 0.0);
+  };
+  for (int j = -200; j <= 200; ++j) {
+    const double a = (j + 0.5) * kStep18, y_car = 49.1 * std::tan(a);
+    for (double e_deg : {-1.2, -0.8, -0.4, 0.0}) {
+      const double e = e_deg * M_PI / 180.0;
+      if (std::abs(y_car) <= 2.25 && y_car < hidden_from) add(49.1, a, e);
+      else if (std::abs(y_car) <= 2.25 + 2.0 && y_car >= hidden_from) add(30.0, a, e);
+      else add(80.0, a, e);
+    }
+    if (ground) add(30.0, a, -3.0 * M_PI / 180.0);  // the road 30 m away, below the car's rings
+  }
+  SideScene s;
+  s.scan.resize(4, static_cast<Eigen::Index>(columns.size()));
+  for (size_t i = 0; i < columns.size(); ++i) s.scan.col(static_cast<Eigen::Index>(i)) = columns[i];
+  return s;
+}
+Box cropOf(double length) {
+  Box crop;
+  crop.center = Eigen::Vector3d(50.0, 0.0, -0.4);
+  crop.size = Eigen::Vector3d(length, 2.2, 2.0);
+  crop.yaw = M_PI / 2;
+  return crop;
+}
+ObjectPoints pointsIn(const PointCloud& scan, const Box& crop) {
+  ObjectPoints points;
+  for (Eigen::Index i = 0; i < scan.cols(); ++i)
+    if (crop.contains(scan.col(i).head<3>().cast<double>())) points.push_back(scan.col(i).head<3>());
+  return points;
+}
+
+}  // namespace
+
+TEST(SideEnds, AnEndIsHiddenWhereSomethingNearerIsBesideIt) {
+  const Box crop = cropOf(4.5 + 1.4);
+  // Nothing in front: the wall behind hides nothing, nor does the road below the car's rings.
+  for (const bool ground : {false, true}) {
+    const SideScene s = sideScene(10.0, ground);
+    const AzimuthIndex index(s.scan, kStep18);
+    const ObjectPoints car = pointsIn(s.scan, crop);
+    const EndsSeen seen = endsSeen(index, car, crop);
+    EXPECT_TRUE(seen.low);
+    EXPECT_TRUE(seen.high);
+  }
+  // Something 30 m away hides the car from y = 1.25 on: its front (+y, high) end is hidden, its
+  // back is not.
+  const SideScene s = sideScene(1.25);
+  const ObjectPoints car = pointsIn(s.scan, crop);
+  const EndsSeen seen = endsSeen(AzimuthIndex(s.scan, kStep18), car, crop);
+  EXPECT_TRUE(seen.low);
+  EXPECT_FALSE(seen.high);
+  EXPECT_NEAR(sideEnds(car, Eigen::Vector3d::UnitY())->high, 1.25, 0.16);
+  // A crop that ends within a column's spacing (0.157 m here) of the ends may have cut them.
+  const Box tight = cropOf(4.6);
+  const SideScene whole = sideScene();
+  const EndsSeen cut = endsSeen(AzimuthIndex(whole.scan, kStep18), pointsIn(whole.scan, tight), tight);
+  EXPECT_FALSE(cut.low);
+  EXPECT_FALSE(cut.high);
+  // Named along -d, the ends swap.
+  EXPECT_FALSE(seen.flipped(true).low);
+  EXPECT_TRUE(seen.flipped(true).high);
+}
+
+TEST(SideEnds, TheAzimuthIndexWrapsAroundBehindTheSensor) {
+  PointCloud scan(4, 3);
+  scan.col(0) << std::cos(M_PI - 0.0005), std::sin(M_PI - 0.0005), 0, 0;
+  scan.col(1) << std::cos(-M_PI + 0.0005), std::sin(-M_PI + 0.0005), 0, 0;
+  scan.col(2) << 1, 0, 0, 0;
+  const AzimuthIndex index(scan, kStep18);
+  std::vector<int> near = index.near(M_PI - 0.002, M_PI + 0.002);
+  std::sort(near.begin(), near.end());
+  EXPECT_EQ(near, (std::vector<int>{0, 1}));
+  EXPECT_EQ(index.near(-0.001, 0.001), std::vector<int>{2});
+}
+
+TEST(SideEnds, ASideCutShortCountsTheEndItSaw) {
+  const double length = 4.5, tolerance = 0.5, box_sigma = 0.3;
+  const SideEnds whole{-2.2, 2.2}, short_front{-2.2, 1.0};
+  // As long as the car: both, whatever the test said.
+  EXPECT_TRUE(endsThatCount(whole, EndsSeen{false, false}, 40, length, tolerance, 0.0, box_sigma, 20).both());
+  // Short: the end the test saw, where the box puts it; both "seen" contradicts the test; too few
+  // points, or an end 3 box sigmas from the box's, count for nothing.
+  const EndsSeen back = endsThatCount(short_front, EndsSeen{true, false}, 40, length, tolerance, 0.0, box_sigma, 20);
+  EXPECT_TRUE(back.low);
+  EXPECT_FALSE(back.high);
+  const auto none = [](const EndsSeen& e) { return !e.low && !e.high; };
+  EXPECT_TRUE(none(endsThatCount(short_front, EndsSeen{}, 40, length, tolerance, 0.0, box_sigma, 20)));
+  EXPECT_TRUE(none(endsThatCount(short_front, EndsSeen{true, false}, 19, length, tolerance, 0.0, box_sigma, 20)));
+  EXPECT_TRUE(none(endsThatCount(short_front, EndsSeen{true, false}, 40, length, tolerance, 1.0, box_sigma, 20)));
+
+  // A pair by its back end alone: that end's motion, its variance twice a middle's.
+  const double s = 0.05, dt = 0.1;
+  const SideView a{SideEnds{-2.2, 1.0}, s, EndsSeen{true, false}}, b{SideEnds{-1.2, 2.3}, s, EndsSeen{}};
+  const std::optional<PairSpeed> p = sidePairSpeed(a, b, Eigen::Vector2d::UnitY(), length, tolerance, dt);
+  ASSERT_TRUE(p);
+  EXPECT_NEAR(p->speed, 10.0, 1e-9);
+  EXPECT_NEAR(p->sigma, std::sqrt(2.0 * 2.0 * s * s) / dt, 1e-9);
+  // No end both saw: nothing.
+  EXPECT_FALSE(sidePairSpeed(a, SideView{b.ends, s, EndsSeen{false, true}}, Eigen::Vector2d::UnitY(), length, tolerance, dt));
+}
+
+TEST(SideEnds, TheLineTakesEachEndWithItsOwnOffset) {
+  // A 4.4 m car at 10 m/s: two whole scans, one whose front is hidden, one whose back is, all on
+  // the line: the slope is exact, its sigma that of each end's own regression on time.
+  const double s = 0.05;
+  std::vector<SideScan> scans = {{0.0, SideView{SideEnds{-2.2, 2.2}, s}},
+                                 {0.1, SideView{SideEnds{-1.2, 3.2}, s}},
+                                 {0.2, SideView{SideEnds{-0.2, 1.5}, s, EndsSeen{true, false}}},
+                                 {0.3, SideView{SideEnds{2.0, 5.2}, s, EndsSeen{false, true}}}};
+  std::optional<SideLine> line = sideLine(scans, 4.4, 0.5);
+  ASSERT_TRUE(line);
+  EXPECT_NEAR(line->speed, 10.0, 1e-9);
+  // Back ends at 0, 0.1, 0.2 s (sum of squares about their mean 0.02), fronts at 0, 0.1, 0.3 s
+  // (0.0467): sigma = s / sqrt(0.0667).
+  EXPECT_NEAR(line->sigma, s / std::sqrt(0.02 + (0.14 / 3.0 * 1.0)), 1e-9);
+  EXPECT_EQ(line->scans, 4);
+  // Among three scans a one-end scan has nothing to be checked by: the line is the whole scans'.
+  scans.pop_back();
+  line = sideLine(scans, 4.4, 0.5);
+  ASSERT_TRUE(line);
+  EXPECT_EQ(line->scans, 2);
+  EXPECT_NEAR(line->sigma, s / std::sqrt(2.0 * (0.0025 + 0.0025)), 1e-9);
 }

@@ -9,6 +9,7 @@
 #include "backend/object_registration.hpp"
 #include "backend/odometry_consistency.hpp"
 #include "backend/se3.hpp"
+#include "backend/side_ends.hpp"
 #include <array>
 #include <memory>
 #include "dlslot/track_lifecycle.hpp"
@@ -34,6 +35,8 @@ struct ObservationInput {
   // The object's points in this scan (lidar frame; the node's selection by its box), when the
   // scan arrived: per-object registration (object_registration.hpp).
   std::shared_ptr<const ObjectPoints> points;
+  // Which of its ends along the box's heading the scan saw whole (side_ends.hpp: endsSeen).
+  EndsSeen ends_seen;
 };
 
 struct BackendInput {

@@ -11,7 +11,8 @@
 
 namespace dlslot::backend {
 
-// Sets `points` of every observation whose class the config registers (lidar frame).
+// Sets `points` of every observation whose class the config registers (lidar frame), and, for a
+// side shorter than its box, which of its ends the scan saw (side_ends.hpp: endsSeen).
 void attachObjectPoints(const PointCloud& scan, const BackendConfig& config, std::vector<ObservationInput>& observations);
 
 }  // namespace dlslot::backend

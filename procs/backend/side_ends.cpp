@@ -23,55 +23,182 @@ double sideEndSigma(double range, double sin_angle, double azimuth_step_rad, dou
   return std::hypot(spacing / std::sqrt(12.0), floor_m);
 }
 
+AzimuthIndex::AzimuthIndex(const PointCloud& scan, double step_rad, const std::vector<const ObjectPoints*>& objects)
+    : scan_(&scan), step_(step_rad) {
+  // The objects' farthest horizontal range and the slopes z / range of their lowest and highest points.
+  double far = std::numeric_limits<double>::infinity(), lowest = -far, highest = far;
+  if (!objects.empty()) {
+    far = 0;
+    std::swap(lowest, highest);
+    for (const ObjectPoints* points : objects)
+      for (const Eigen::Vector3f& p : *points) {
+        const double r = std::hypot(p.x(), p.y());
+        if (r < 1e-6) continue;
+        far = std::max(far, r);
+        lowest = std::min(lowest, p.z() / r);
+        highest = std::max(highest, p.z() / r);
+      }
+  }
+  const int bins = static_cast<int>(std::ceil(2.0 * M_PI / step_));
+  std::vector<int> bin(scan.cols(), -1);
+  start_.assign(bins + 1, 0);
+  const double far2 = far * far;
+  for (Eigen::Index i = 0; i < scan.cols(); ++i) {
+    const double x = scan(0, i), y = scan(1, i), z = scan(2, i), r2 = x * x + y * y;
+    if (r2 >= far2) continue;
+    const double r = std::sqrt(r2);
+    if (z < lowest * r || z > highest * r) continue;
+    bin[i] = std::min(static_cast<int>((std::atan2(y, x) + M_PI) / step_), bins - 1);
+    ++start_[bin[i] + 1];
+  }
+  for (int b = 0; b < bins; ++b) start_[b + 1] += start_[b];
+  order_.resize(start_.back());
+  std::vector<int> next(start_.begin(), start_.end() - 1);
+  for (Eigen::Index i = 0; i < scan.cols(); ++i)
+    if (bin[i] >= 0) order_[next[bin[i]]++] = static_cast<int>(i);
+}
+
+std::vector<int> AzimuthIndex::near(double from, double to) const {
+  const int bins = static_cast<int>(start_.size()) - 1;
+  const int first = static_cast<int>(std::floor((from + M_PI) / step_));
+  const int count = std::min(bins, static_cast<int>(std::floor((to + M_PI) / step_)) - first + 1);
+  std::vector<int> out;
+  for (int k = 0; k < count; ++k) {
+    const int b = ((first + k) % bins + bins) % bins;
+    out.insert(out.end(), order_.begin() + start_[b], order_.begin() + start_[b + 1]);
+  }
+  return out;
+}
+
+EndsSeen endsSeen(const AzimuthIndex& index, const ObjectPoints& points, const Box& crop) {
+  const Eigen::Vector3d d(std::cos(crop.yaw), std::sin(crop.yaw), 0.0);
+  const std::optional<SideEnds> ends = sideEnds(points, d);
+  const Eigen::Vector2d c = crop.center.head<2>();
+  if (!ends || c.norm() < 1e-3) return EndsSeen{false, false};
+  const double sin_angle = std::abs(d.x() * c.y() - d.y() * c.x()) / c.norm();
+  const double spacing = c.norm() * index.step() / std::max(sin_angle, 1e-3);
+  const double centre = d.dot(crop.center);
+  // An occluder hides the object on the rings that hit it: at the elevations of its points.
+  const auto elevation = [](double x, double y, double z) { return std::atan2(z, std::hypot(x, y)); };
+  double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+  for (const Eigen::Vector3f& p : points) {
+    const double e = elevation(p.x(), p.y(), p.z());
+    lowest = std::min(lowest, e);
+    highest = std::max(highest, e);
+  }
+  const BoxContainment own(crop, 0.0);
+  const PointCloud& scan = index.scan();
+  const auto hidden = [&](double end, double crop_end) {
+    if (std::abs(crop_end - end) < spacing) return true;
+    // The azimuths (about the first such point's, so none wraps) and nearest range of the end's points.
+    std::optional<double> reference;
+    double lo = 0, hi = 0, nearest = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3f& p : points) {
+      if (std::abs(d.dot(p.cast<double>()) - end) > spacing) continue;
+      const double a = std::atan2(p.y(), p.x());
+      if (!reference) reference = a;
+      const double r = std::remainder(a - *reference, 2.0 * M_PI);
+      lo = std::min(lo, r);
+      hi = std::max(hi, r);
+      nearest = std::min(nearest, std::hypot(static_cast<double>(p.x()), static_cast<double>(p.y())));
+    }
+    if (!reference) return true;
+    const double margin = 2.0 * index.step();
+    for (int i : index.near(*reference + lo - margin, *reference + hi + margin)) {
+      const double x = scan(0, i), y = scan(1, i), z = scan(2, i);
+      const double e = elevation(x, y, z);
+      if (e < lowest || e > highest || own.contains(x, y, z)) continue;
+      if (std::hypot(x, y) < nearest) return true;
+    }
+    return false;
+  };
+  return EndsSeen{!hidden(ends->low, centre - 0.5 * crop.size.x()), !hidden(ends->high, centre + 0.5 * crop.size.x())};
+}
+
+EndsSeen endsThatCount(const SideEnds& ends, EndsSeen seen, int points, double vehicle_length, double length_tolerance,
+                       double box_middle, double box_sigma, int min_points) {
+  if (ends.length() >= vehicle_length - length_tolerance) return EndsSeen{};
+  if (seen.both() || points < min_points) return EndsSeen{false, false};
+  const double limit = 3.0 * box_sigma;
+  seen.low = seen.low && std::abs(ends.low - (box_middle - 0.5 * vehicle_length)) <= limit;
+  seen.high = seen.high && std::abs(ends.high - (box_middle + 0.5 * vehicle_length)) <= limit;
+  return seen;
+}
+
 std::optional<PairSpeed> sidePairSpeed(const SideView& previous, const SideView& current, const Eigen::Vector2d& d,
                                        double vehicle_length, double length_tolerance, double dt) {
   if (!(dt > 0)) return std::nullopt;
   const double l0 = previous.ends.length(), l1 = current.ends.length();
-  if (std::abs(l0 - vehicle_length) > length_tolerance || std::abs(l1 - vehicle_length) > length_tolerance)
-    return std::nullopt;
   const double v0 = previous.end_sigma * previous.end_sigma, v1 = current.end_sigma * current.end_sigma;
-  // A length is the difference of two ends; the change of length that of two lengths.
-  if (std::abs(l1 - l0) > 3.0 * std::sqrt(2.0 * v0 + 2.0 * v1)) return std::nullopt;
   PairSpeed p;
   p.u = d;
-  p.speed = (current.ends.middle() - previous.ends.middle()) / dt;
-  p.sigma = std::sqrt(v0 + v1) / dt;
+  if (previous.seen.both() && current.seen.both()) {
+    if (std::abs(l0 - vehicle_length) > length_tolerance || std::abs(l1 - vehicle_length) > length_tolerance)
+      return std::nullopt;
+    // A length is the difference of two ends; the change of length that of two lengths.
+    if (std::abs(l1 - l0) > 3.0 * std::sqrt(2.0 * v0 + 2.0 * v1)) return std::nullopt;
+    p.speed = (current.ends.middle() - previous.ends.middle()) / dt;
+    p.sigma = std::sqrt(v0 + v1) / dt;
+  } else {
+    if (previous.seen.low && current.seen.low)
+      p.speed = (current.ends.low - previous.ends.low) / dt;
+    else if (previous.seen.high && current.seen.high)
+      p.speed = (current.ends.high - previous.ends.high) / dt;
+    else
+      return std::nullopt;
+    p.sigma = std::sqrt(2.0 * (v0 + v1)) / dt;
+  }
   if (!std::isfinite(p.speed) || !(p.sigma > 0) || !std::isfinite(p.sigma)) return std::nullopt;
   return p;
 }
 
 namespace {
 
-// Weighted least squares of the middles on time (a middle's variance s^2 / 2), with the intercept
-// at the weighted mean time; nothing without two distinct times.
-struct MiddlesFit {
-  SideLine line;
-  double intercept = 0, intercept_variance = 0;
+// One end of one scan: its position along d, its time and variance.
+struct EndSample {
+  double time = 0, position = 0, variance = 0;
 };
-std::optional<MiddlesFit> fitMiddles(const std::vector<const SideScan*>& scans) {
-  const auto weight = [](const SideScan* s) { return 2.0 / (s->view.end_sigma * s->view.end_sigma); };
-  double sw = 0, st = 0, sy = 0;
-  for (const SideScan* s : scans) {
-    sw += weight(s);
-    st += weight(s) * s->time;
-    sy += weight(s) * s->view.ends.middle();
-  }
-  if (scans.size() < 2 || !(sw > 0)) return std::nullopt;
-  const double t_mean = st / sw;
+
+// Weighted least squares of the ends on time, each end (low, high) with its own intercept at its
+// weighted mean time, and the weight behind each intercept. Nothing without two distinct times on
+// a common end.
+struct EndsFit {
+  SideLine line;
+  double mean_time[2] = {0, 0}, mean_position[2] = {0, 0}, weight[2] = {0, 0};
+  // An end's position at `time` as the fit gives it.
+  double at(int end, double time) const { return mean_position[end] + line.speed * (time - mean_time[end]); }
+};
+using ScanEnds = std::vector<std::pair<int, EndSample>>;  // (end: 0 low, 1 high, sample)
+
+std::optional<EndsFit> fitEnds(const std::vector<const ScanEnds*>& scans) {
+  EndsFit fit;
+  double sw = 0, swt = 0;
+  for (const ScanEnds* s : scans)
+    for (const auto& [end, e] : *s) {
+      const double w = 1.0 / e.variance;
+      fit.weight[end] += w;
+      fit.mean_time[end] += w * e.time;
+      fit.mean_position[end] += w * e.position;
+      sw += w;
+      swt += w * e.time;
+    }
+  for (int end = 0; end < 2; ++end)
+    if (fit.weight[end] > 0) {
+      fit.mean_time[end] /= fit.weight[end];
+      fit.mean_position[end] /= fit.weight[end];
+    }
   double stt = 0, sty = 0;
-  for (const SideScan* s : scans) {
-    const double dt = s->time - t_mean;
-    stt += weight(s) * dt * dt;
-    sty += weight(s) * dt * s->view.ends.middle();
-  }
-  if (!(stt > 1e-12)) return std::nullopt;
-  MiddlesFit fit;
+  for (const ScanEnds* s : scans)
+    for (const auto& [end, e] : *s) {
+      const double dt = e.time - fit.mean_time[end];
+      stt += dt * dt / e.variance;
+      sty += dt * (e.position - fit.mean_position[end]) / e.variance;
+    }
+  if (!(stt > 1e-12) || !(sw > 0)) return std::nullopt;
   fit.line.speed = sty / stt;
   fit.line.sigma = 1.0 / std::sqrt(stt);
-  fit.line.time = t_mean;
+  fit.line.time = swt / sw;
   fit.line.scans = static_cast<int>(scans.size());
-  fit.intercept = sy / sw;
-  fit.intercept_variance = 1.0 / sw;
   return fit;
 }
 
@@ -80,34 +207,55 @@ std::optional<MiddlesFit> fitMiddles(const std::vector<const SideScan*>& scans) 
 std::optional<SideLine> sideLine(const std::vector<SideScan>& scans, double vehicle_length, double length_tolerance) {
   std::vector<double> lengths;
   for (const SideScan& s : scans)
-    if (std::abs(s.view.ends.length() - vehicle_length) <= length_tolerance) lengths.push_back(s.view.ends.length());
-  if (lengths.size() < 2) return std::nullopt;
-  std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
-  const double median_length = lengths[lengths.size() / 2];
-  std::vector<const SideScan*> kept;
-  for (const SideScan& s : scans) {
-    const double l = s.view.ends.length();
-    // A length is the difference of two ends (variance 2 s^2), two lengths' difference 4 s^2.
-    if (s.view.end_sigma > 0 && std::abs(l - vehicle_length) <= length_tolerance &&
-        std::abs(l - median_length) <= 3.0 * 2.0 * s.view.end_sigma)
-      kept.push_back(&s);
+    if (s.view.seen.both() && std::abs(s.view.ends.length() - vehicle_length) <= length_tolerance)
+      lengths.push_back(s.view.ends.length());
+  double median_length = vehicle_length;
+  if (!lengths.empty()) {
+    std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
+    median_length = lengths[lengths.size() / 2];
   }
-  // Each middle against the line through the others (a stray middle at either end of the run
-  // pulls the line through all of them toward itself), in the standard deviations of the
-  // difference: the one furthest off beyond three is left out.
+  std::vector<ScanEnds> samples;
+  for (const SideScan& s : scans) {
+    const double l = s.view.ends.length(), variance = s.view.end_sigma * s.view.end_sigma;
+    if (!(s.view.end_sigma > 0) || !std::isfinite(variance)) continue;
+    ScanEnds ends;
+    if (s.view.seen.both()) {
+      // A length is the difference of two ends (variance 2 s^2), two lengths' difference 4 s^2.
+      if (std::abs(l - vehicle_length) > length_tolerance || std::abs(l - median_length) > 3.0 * 2.0 * s.view.end_sigma)
+        continue;
+    }
+    if (s.view.seen.low) ends.push_back({0, EndSample{s.time, s.view.ends.low, variance}});
+    if (s.view.seen.high) ends.push_back({1, EndSample{s.time, s.view.ends.high, variance}});
+    if (!ends.empty()) samples.push_back(std::move(ends));
+  }
+  std::vector<const ScanEnds*> kept;
+  for (const ScanEnds& s : samples)
+    if (samples.size() >= 4 || s.size() == 2) kept.push_back(&s);
+  // Each scan against the line through the others (a stray scan at either end of the run pulls
+  // the line through all of them toward itself), in the standard deviations of the difference of
+  // its seen ends' mean: the one furthest off beyond three is left out.
   if (kept.size() >= 4) {
     auto worst = kept.end();
     double worst_z = 3.0;
     for (auto it = kept.begin(); it != kept.end(); ++it) {
-      std::vector<const SideScan*> others(kept.begin(), kept.end());
+      std::vector<const ScanEnds*> others(kept.begin(), kept.end());
       others.erase(others.begin() + (it - kept.begin()));
-      const std::optional<MiddlesFit> fit = fitMiddles(others);
+      const std::optional<EndsFit> fit = fitEnds(others);
       if (!fit) continue;
-      const double dt = (*it)->time - fit->line.time;
-      const double predicted = fit->intercept + fit->line.speed * dt;
-      const double variance = 0.5 * (*it)->view.end_sigma * (*it)->view.end_sigma + fit->intercept_variance +
-                              fit->line.sigma * fit->line.sigma * dt * dt;
-      const double z = std::abs((*it)->view.ends.middle() - predicted) / std::sqrt(variance);
+      // The mean of its ends' residuals: their own and their intercepts' variances average down,
+      // the slope's does not (one slope for both).
+      double residual = 0, variance = 0, dt = 0;
+      const double n = static_cast<double>((*it)->size());
+      bool fitted = true;
+      for (const auto& [end, e] : **it) {
+        if (!(fit->weight[end] > 0)) fitted = false;
+        residual += (e.position - fit->at(end, e.time)) / n;
+        variance += (e.variance + 1.0 / fit->weight[end]) / (n * n);
+        dt += (e.time - fit->mean_time[end]) / n;
+      }
+      if (!fitted) continue;
+      variance += fit->line.sigma * fit->line.sigma * dt * dt;
+      const double z = std::abs(residual) / std::sqrt(variance);
       if (z > worst_z) {
         worst_z = z;
         worst = it;
@@ -115,7 +263,7 @@ std::optional<SideLine> sideLine(const std::vector<SideScan>& scans, double vehi
     }
     if (worst != kept.end()) kept.erase(worst);
   }
-  const std::optional<MiddlesFit> fit = fitMiddles(kept);
+  const std::optional<EndsFit> fit = fitEnds(kept);
   if (!fit) return std::nullopt;
   return fit->line;
 }

@@ -288,7 +288,7 @@ void SlidingWindow::registerPoints(Track& track, const ObservationInput& obs, in
   // line_of_sight_chain is set, and needs none otherwise.
   if (!track.velocity_from_chain || config_.line_of_sight_chain) {
     out.line_of_sight_pairs += measureLineOfSight(track, world, obs.box, frame, X, frame_dt);
-    out.side_pairs += measureSideEnds(track, world, obs.box, frame, X);
+    out.side_pairs += measureSideEnds(track, world, obs, frame, X);
   }
   const std::shared_ptr<const PreparedObject> previous = track.points;
   const int previous_frame = track.points_frame;
@@ -364,8 +364,9 @@ bool SlidingWindow::measureLineOfSight(Track& track, const ObjectPoints& world, 
   return paired;
 }
 
-bool SlidingWindow::measureSideEnds(Track& track, const ObjectPoints& world, const Box& box, int frame,
+bool SlidingWindow::measureSideEnds(Track& track, const ObjectPoints& world, const ObservationInput& obs, int frame,
                                    const Pose& X) const {
+  const Box& box = obs.box;
   const Eigen::Vector2d c = box.center.head<2>();
   if (config_.side_azimuth_step_deg <= 0 || config_.line_of_sight_pairs <= 0 || c.norm() < 1e-3 ||
       static_cast<int>(world.size()) < config_.line_of_sight_young_min_points ||
@@ -377,7 +378,8 @@ bool SlidingWindow::measureSideEnds(Track& track, const ObjectPoints& world, con
   track.side_scans[frame] = Track::SideScanPoints{
       std::make_shared<const ObjectPoints>(world), Eigen::Vector3d(std::cos(yaw), std::sin(yaw), 0.0),
       sideEndSigma(c.norm(), sin_angle, config_.side_azimuth_step_deg * M_PI / 180.0, config_.registration.accuracy_m),
-      X.translation()};
+      obs.ends_seen, X.translation(), X * box.center,
+      config_.observation_sigma[0] * config_.observationNoiseGrowth(c.norm())};
   return sidePair(track, frame - 1, frame).has_value();
 }
 
@@ -385,14 +387,24 @@ std::optional<PairSpeed> SlidingWindow::sidePair(const Track& track, int f0, int
   const auto previous = track.side_scans.find(f0), current = track.side_scans.find(f1);
   if (previous == track.side_scans.end() || current == track.side_scans.end()) return std::nullopt;
   const Track::SideScanPoints &a = previous->second, &b = current->second;
-  const std::optional<SideEnds> ends_a = sideEnds(*a.points, a.d), ends_b = sideEnds(*b.points, a.d);
-  if (!ends_a || !ends_b) return std::nullopt;
-  std::optional<PairSpeed> p = sidePairSpeed(SideView{*ends_a, a.end_sigma}, SideView{*ends_b, b.end_sigma}, a.d.head<2>(),
-                                             track.size.x(), config_.side_length_tolerance, secondsBetween(f0, f1));
+  const std::optional<SideView> view_a = sideView(track, a, a.d), view_b = sideView(track, b, a.d);
+  if (!view_a || !view_b) return std::nullopt;
+  std::optional<PairSpeed> p = sidePairSpeed(*view_a, *view_b, a.d.head<2>(), track.size.x(), config_.side_length_tolerance,
+                                             secondsBetween(f0, f1));
   if (!p) return std::nullopt;
   p->sensor_displacement = a.d.dot(b.sensor - a.sensor);
   p->points = static_cast<int>(std::min(a.points->size(), b.points->size()));
   return p;
+}
+
+std::optional<SideView> SlidingWindow::sideView(const Track& track, const Track::SideScanPoints& scan,
+                                                const Eigen::Vector3d& u) const {
+  const std::optional<SideEnds> ends = sideEnds(*scan.points, u);
+  if (!ends) return std::nullopt;
+  const EndsSeen seen =
+      endsThatCount(*ends, scan.seen.flipped(u.dot(scan.d) < 0), static_cast<int>(scan.points->size()), track.size.x(),
+                    config_.side_length_tolerance, u.dot(scan.box_center), scan.box_sigma, config_.line_of_sight_min_points);
+  return SideView{*ends, scan.end_sigma, seen};
 }
 
 std::optional<VelocityEvidence> SlidingWindow::sideVelocity(const Track& track) const {
@@ -401,8 +413,8 @@ std::optional<VelocityEvidence> SlidingWindow::sideVelocity(const Track& track) 
   std::vector<SideScan> scans;
   for (const auto& [f, scan] : track.side_scans)
     if (const EgoFrame* ego = findFrame(f))
-      if (const std::optional<SideEnds> ends = sideEnds(*scan.points, d))
-        scans.push_back(SideScan{1e-6 * static_cast<double>(ego->utime), SideView{*ends, scan.end_sigma}});
+      if (const std::optional<SideView> view = sideView(track, scan, d))
+        scans.push_back(SideScan{1e-6 * static_cast<double>(ego->utime), *view});
   const std::optional<SideLine> line = sideLine(scans, track.size.x(), config_.side_length_tolerance);
   if (!line) return std::nullopt;
   const double age = 1e-6 * static_cast<double>(frames_.back().utime) - line->time;

@@ -114,13 +114,16 @@ class SlidingWindow {
     std::optional<SightFace> sight;
     std::map<int, PairSpeed> sight_speeds;
     // The scans whose box showed its side: its points (world), the box's heading d (world), one
-    // end's standard deviation and the ego position the points were put in the world with
-    // (side_ends.hpp).
+    // end's standard deviation, which ends (along d) the scan saw and the ego position the points
+    // were put in the world with (side_ends.hpp).
     struct SideScanPoints {
       std::shared_ptr<const ObjectPoints> points;
       Eigen::Vector3d d = Eigen::Vector3d::UnitX();
       double end_sigma = 0;
+      EndsSeen seen;
       Eigen::Vector3d sensor = Eigen::Vector3d::Zero();
+      Eigen::Vector3d box_center = Eigen::Vector3d::Zero();  // world
+      double box_sigma = 0;  // of the box's position at its range
     };
     std::map<int, SideScanPoints> side_scans;
     // A vehicle's heading from its faces' points, per scan (face_heading.hpp; yaw in the scan's axes).
@@ -144,10 +147,12 @@ class SlidingWindow {
                           double dt) const;
   // This scan's points when its box shows the side (side_ends.hpp); true when the scan before did
   // too and the pair counts.
-  bool measureSideEnds(Track& track, const ObjectPoints& world, const Box& box, int frame, const Pose& X) const;
+  bool measureSideEnds(Track& track, const ObjectPoints& world, const ObservationInput& obs, int frame, const Pose& X) const;
   // The side's ends' speed along the heading of scan f0 over f0 -> f1, if both show the side and
   // the pair counts (sidePairSpeed).
   std::optional<PairSpeed> sidePair(const Track& track, int f0, int f1) const;
+  // A side scan's ends along u and those that count (endsThatCount, named along u).
+  std::optional<SideView> sideView(const Track& track, const Track::SideScanPoints& scan, const Eigen::Vector3d& u) const;
   // The line through the middles of the window's side scans along the newest one's heading
   // (sideLine), as a velocity at the newest frame: its variance grown by vehicle_acceleration over
   // the time from the scans' mean.

@@ -66,6 +66,8 @@ struct BackendConfig {
   double observation_sigma_growth_per_m = 0.0;
   // Factor by which a box's translation sigmas grow at this range.
   double observationNoiseGrowth(double range_m) const { return 1.0 + observation_sigma_growth_per_m * range_m; }
+  // A box's position sigma along its length at this range.
+  double boxLengthwiseSigma(double range_m) const { return observation_sigma[0] * observationNoiseGrowth(range_m); }
   // The sigmas of a box of this class (a moving object's or a landmark's): the configured ones,
   // with the class's heading sigma when that is larger.
   Vector6 boxSigma(const std::string& type, bool moving) const;

@@ -16,7 +16,7 @@ void attachObjectPoints(const PointCloud& scan, const BackendConfig& config, std
     if (std::find(config.registration_types.begin(), config.registration_types.end(), o.box.type) ==
         config.registration_types.end())
       continue;
-    const double sigma = config.observation_sigma[0] * config.observationNoiseGrowth(o.box.center.norm());
+    const double sigma = config.boxLengthwiseSigma(o.box.center.norm());
     const double margin = std::max(config.registration_box_margin, config.registration_box_margin_sigmas * sigma);
     const Box v = removalVolume(o.box, margin, config.registration_ground_clearance);
     if (v.size.z() <= 0.0) continue;

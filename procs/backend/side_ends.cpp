@@ -17,37 +17,60 @@ std::optional<SideEnds> sideEnds(const ObjectPoints& points, const Eigen::Vector
   return e;
 }
 
+double sideSine(const Box& box) {
+  const Eigen::Vector2d c = box.center.head<2>();
+  if (c.norm() < 1e-6) return 0.0;
+  return std::abs(std::cos(box.yaw) * c.y() - std::sin(box.yaw) * c.x()) / c.norm();
+}
+
+double columnSpacing(double range, double sin_angle, double azimuth_step_rad) {
+  return range * azimuth_step_rad / std::max(std::abs(sin_angle), 1e-3);
+}
+
 double sideEndSigma(double range, double sin_angle, double azimuth_step_rad, double floor_m) {
   // A uniform error over a width w has standard deviation w / sqrt(12).
-  const double spacing = range * azimuth_step_rad / std::max(std::abs(sin_angle), 1e-3);
-  return std::hypot(spacing / std::sqrt(12.0), floor_m);
+  return std::hypot(columnSpacing(range, sin_angle, azimuth_step_rad) / std::sqrt(12.0), floor_m);
 }
+
+namespace {
+
+// Where points lie as the sensor sees them: their farthest horizontal range and the lowest and
+// highest slope z / range (an elevation's tangent: a ring keeps its slope). Widened by `points`.
+struct SightBand {
+  double far = 0;
+  double lowest = std::numeric_limits<double>::infinity(), highest = -std::numeric_limits<double>::infinity();
+  void widen(const ObjectPoints& points) {
+    for (const Eigen::Vector3f& p : points) {
+      const double r = std::hypot(p.x(), p.y());
+      if (r < 1e-6) continue;
+      far = std::max(far, r);
+      lowest = std::min(lowest, p.z() / r);
+      highest = std::max(highest, p.z() / r);
+    }
+  }
+  // The points of another object on one of these rings have its very slope: held to within the
+  // coordinates' rounding (1e-4, 0.006 deg; the rings are 0.4 deg apart), not left to it.
+  bool holdsSlope(double z, double r) const { return z >= (lowest - 1e-4) * r && z <= (highest + 1e-4) * r; }
+};
+
+}  // namespace
 
 AzimuthIndex::AzimuthIndex(const PointCloud& scan, double step_rad, const std::vector<const ObjectPoints*>& objects)
     : scan_(&scan), step_(step_rad) {
-  // The objects' farthest horizontal range and the slopes z / range of their lowest and highest points.
-  double far = std::numeric_limits<double>::infinity(), lowest = -far, highest = far;
-  if (!objects.empty()) {
-    far = 0;
-    std::swap(lowest, highest);
-    for (const ObjectPoints* points : objects)
-      for (const Eigen::Vector3f& p : *points) {
-        const double r = std::hypot(p.x(), p.y());
-        if (r < 1e-6) continue;
-        far = std::max(far, r);
-        lowest = std::min(lowest, p.z() / r);
-        highest = std::max(highest, p.z() / r);
-      }
+  SightBand band;
+  if (objects.empty()) {
+    band.far = std::numeric_limits<double>::infinity();
+    band.lowest = -band.far;
+    band.highest = band.far;
   }
+  for (const ObjectPoints* points : objects) band.widen(*points);
   const int bins = static_cast<int>(std::ceil(2.0 * M_PI / step_));
   std::vector<int> bin(scan.cols(), -1);
   start_.assign(bins + 1, 0);
-  const double far2 = far * far;
+  const double far2 = band.far * band.far;
   for (Eigen::Index i = 0; i < scan.cols(); ++i) {
     const double x = scan(0, i), y = scan(1, i), z = scan(2, i), r2 = x * x + y * y;
-    if (r2 >= far2) continue;
-    const double r = std::sqrt(r2);
-    if (z < lowest * r || z > highest * r) continue;
+    if (r2 >= far2 || !band.holdsSlope(z, std::sqrt(r2))) continue;
     bin[i] = std::min(static_cast<int>((std::atan2(y, x) + M_PI) / step_), bins - 1);
     ++start_[bin[i] + 1];
   }
@@ -73,19 +96,13 @@ std::vector<int> AzimuthIndex::near(double from, double to) const {
 EndsSeen endsSeen(const AzimuthIndex& index, const ObjectPoints& points, const Box& crop) {
   const Eigen::Vector3d d(std::cos(crop.yaw), std::sin(crop.yaw), 0.0);
   const std::optional<SideEnds> ends = sideEnds(points, d);
-  const Eigen::Vector2d c = crop.center.head<2>();
-  if (!ends || c.norm() < 1e-3) return EndsSeen{false, false};
-  const double sin_angle = std::abs(d.x() * c.y() - d.y() * c.x()) / c.norm();
-  const double spacing = c.norm() * index.step() / std::max(sin_angle, 1e-3);
+  const double range = crop.center.head<2>().norm();
+  if (!ends || range < 1e-3) return EndsSeen{false, false};
+  const double spacing = columnSpacing(range, sideSine(crop), index.step());
   const double centre = d.dot(crop.center);
   // An occluder hides the object on the rings that hit it: at the elevations of its points.
-  const auto elevation = [](double x, double y, double z) { return std::atan2(z, std::hypot(x, y)); };
-  double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
-  for (const Eigen::Vector3f& p : points) {
-    const double e = elevation(p.x(), p.y(), p.z());
-    lowest = std::min(lowest, e);
-    highest = std::max(highest, e);
-  }
+  SightBand band;
+  band.widen(points);
   const BoxContainment own(crop, 0.0);
   const PointCloud& scan = index.scan();
   const auto hidden = [&](double end, double crop_end) {
@@ -105,10 +122,9 @@ EndsSeen endsSeen(const AzimuthIndex& index, const ObjectPoints& points, const B
     if (!reference) return true;
     const double margin = 2.0 * index.step();
     for (int i : index.near(*reference + lo - margin, *reference + hi + margin)) {
-      const double x = scan(0, i), y = scan(1, i), z = scan(2, i);
-      const double e = elevation(x, y, z);
-      if (e < lowest || e > highest || own.contains(x, y, z)) continue;
-      if (std::hypot(x, y) < nearest) return true;
+      const double x = scan(0, i), y = scan(1, i), z = scan(2, i), r = std::hypot(x, y);
+      if (!band.holdsSlope(z, r) || own.contains(x, y, z)) continue;
+      if (r < nearest) return true;
     }
     return false;
   };

@@ -31,9 +31,13 @@ struct SideEnds {
 // Nothing for fewer than two points.
 std::optional<SideEnds> sideEnds(const ObjectPoints& points, const Eigen::Vector3d& d);
 
-// The standard deviation (m) of one end: uniform over the columns' spacing along the side, the
-// azimuth step at `range` over the sine of the angle between the side and the line of sight,
-// and the floor (the sensor's own noise; a ring crossing the rounded end at another height).
+// The sine of the angle between a box's heading and the line of sight to its centre (0 end-on).
+double sideSine(const Box& box);
+// The spacing (m) of the lidar's columns along a side seen at that angle: the azimuth step at
+// `range` over the sine.
+double columnSpacing(double range, double sin_angle, double azimuth_step_rad);
+// The standard deviation (m) of one end: uniform over the columns' spacing along the side, and
+// the floor (the sensor's own noise; a ring crossing the rounded end at another height).
 double sideEndSigma(double range, double sin_angle, double azimuth_step_rad, double floor_m);
 
 // Which of a scan's two ends along its box's heading the sensor saw whole. A car that something
@@ -79,7 +83,7 @@ EndsSeen endsSeen(const AzimuthIndex& index, const ObjectPoints& points, const B
 // box_sigma off:
 // - a side as long as the vehicle (no more than length_tolerance shorter) counts both: its ends
 //   are where they are whatever the test says, which also hides an end one ring sees past an
-//   occluder on another (refusing those scans cost the intersection 3-10 %);
+//   occluder on another (refusing those scans cost the intersection 2-10 %);
 // - a shorter side the test saw whole contradicts it: neither;
 // - the one end it saw counts from min_points points (with fewer, where the rings happen to fall)
 //   and where the box puts it, within three box sigmas: an end that returned no points (glass; far

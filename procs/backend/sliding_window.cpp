@@ -373,13 +373,11 @@ bool SlidingWindow::measureSideEnds(Track& track, const ObjectPoints& world, con
       facesTheSensor(box, config_.line_of_sight_max_angle_deg))
     return false;
   // The angle between the side and the line of sight widens the columns' spacing along it.
-  const double sin_angle = std::abs(std::cos(box.yaw) * c.y() - std::sin(box.yaw) * c.x()) / c.norm();
   const double yaw = box.yaw + yawOf(X.linear());
   track.side_scans[frame] = Track::SideScanPoints{
       std::make_shared<const ObjectPoints>(world), Eigen::Vector3d(std::cos(yaw), std::sin(yaw), 0.0),
-      sideEndSigma(c.norm(), sin_angle, config_.side_azimuth_step_deg * M_PI / 180.0, config_.registration.accuracy_m),
-      obs.ends_seen, X.translation(), X * box.center,
-      config_.observation_sigma[0] * config_.observationNoiseGrowth(c.norm())};
+      sideEndSigma(c.norm(), sideSine(box), config_.side_azimuth_step_deg * M_PI / 180.0, config_.registration.accuracy_m),
+      obs.ends_seen, X.translation(), X * box.center, config_.boxLengthwiseSigma(c.norm())};
   return sidePair(track, frame - 1, frame).has_value();
 }
 

@@ -153,7 +153,7 @@ class SlidingWindow {
   std::optional<PairSpeed> sidePair(const Track& track, int f0, int f1) const;
   // A side scan's ends along u and those that count (endsThatCount, named along u).
   std::optional<SideView> sideView(const Track& track, const Track::SideScanPoints& scan, const Eigen::Vector3d& u) const;
-  // The line through the middles of the window's side scans along the newest one's heading
+  // The line through the ends that count of the window's side scans along the newest one's heading
   // (sideLine), as a velocity at the newest frame: its variance grown by vehicle_acceleration over
   // the time from the scans' mean.
   std::optional<VelocityEvidence> sideVelocity(const Track& track) const;

@@ -39,6 +39,11 @@ namespace {
 struct SightBand {
   double far = 0;
   double lowest = std::numeric_limits<double>::infinity(), highest = -std::numeric_limits<double>::infinity();
+  // Every point (an index with no objects to serve keeps them all).
+  static SightBand everything() {
+    const double inf = std::numeric_limits<double>::infinity();
+    return SightBand{inf, -inf, inf};
+  }
   void widen(const ObjectPoints& points) {
     for (const Eigen::Vector3f& p : points) {
       const double r = std::hypot(p.x(), p.y());
@@ -57,12 +62,7 @@ struct SightBand {
 
 AzimuthIndex::AzimuthIndex(const PointCloud& scan, double step_rad, const std::vector<const ObjectPoints*>& objects)
     : scan_(&scan), step_(step_rad) {
-  SightBand band;
-  if (objects.empty()) {
-    band.far = std::numeric_limits<double>::infinity();
-    band.lowest = -band.far;
-    band.highest = band.far;
-  }
+  SightBand band = objects.empty() ? SightBand::everything() : SightBand{};
   for (const ObjectPoints* points : objects) band.widen(*points);
   const int bins = static_cast<int>(std::ceil(2.0 * M_PI / step_));
   std::vector<int> bin(scan.cols(), -1);

@@ -378,7 +378,9 @@ bool SlidingWindow::measureSideEnds(Track& track, const ObjectPoints& world, con
       std::make_shared<const ObjectPoints>(world), Eigen::Vector3d(std::cos(yaw), std::sin(yaw), 0.0),
       sideEndSigma(c.norm(), sideSine(box), config_.side_azimuth_step_deg * M_PI / 180.0, config_.registration.accuracy_m),
       obs.ends_seen, X.translation(), X * box.center, config_.boxLengthwiseSigma(c.norm())};
-  return sidePair(track, frame - 1, frame).has_value();
+  const std::optional<PairSpeed> pair = sidePair(track, frame - 1, frame);
+  if (pair) track.side_speeds[frame] = *pair;
+  return pair.has_value();
 }
 
 std::optional<PairSpeed> SlidingWindow::sidePair(const Track& track, int f0, int f1) const {
@@ -672,7 +674,7 @@ void SlidingWindow::addPairSpeedFactors(const Track& track, int f) {
   };
   if (const auto sight = track.sight_speeds.find(f); sight != track.sight_speeds.end() && !track.motions.count(f))
     add(sight->second);
-  if (const std::optional<PairSpeed> side = sidePair(track, f - 1, f)) add(*side);
+  if (const auto side = track.side_speeds.find(f); side != track.side_speeds.end()) add(side->second);
 }
 
 void SlidingWindow::startStraight(const Track& track, int f, double* change, const Eigen::Vector3d& displacement) {
@@ -988,6 +990,7 @@ SmoothedPose SlidingWindow::slide() {
     track.motions.erase(track.motions.begin(), track.motions.upper_bound(s));
     track.sight_speeds.erase(track.sight_speeds.begin(), track.sight_speeds.upper_bound(s));
     track.side_scans.erase(track.side_scans.begin(), track.side_scans.upper_bound(s));
+    track.side_speeds.erase(track.side_speeds.begin(), track.side_speeds.upper_bound(s));
     track.face_headings.erase(track.face_headings.begin(), track.face_headings.upper_bound(s));
   }
   for (Track* track : left_view) {

@@ -126,6 +126,7 @@ class SlidingWindow {
       double box_sigma = 0;  // of the box's position at its range
     };
     std::map<int, SideScanPoints> side_scans;
+    std::map<int, PairSpeed> side_speeds;  // each side scan pair's (frame t -> t-1 to t), measured at t
     // A vehicle's heading from its faces' points, per scan (face_heading.hpp; yaw in the scan's axes).
     std::map<int, FaceHeading> face_headings;
     Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
@@ -145,8 +146,8 @@ class SlidingWindow {
   // before had one, the pair's speed along it (line_of_sight.hpp); true when it measured a pair.
   bool measureLineOfSight(Track& track, const ObjectPoints& world, const Box& box, int frame, const Pose& X,
                           double dt) const;
-  // This scan's points when its box shows the side (side_ends.hpp); true when the scan before did
-  // too and the pair counts.
+  // This scan's points when its box shows the side (side_ends.hpp) and, when the scan before did
+  // too and the pair counts, the pair's speed; true when it measured a pair.
   bool measureSideEnds(Track& track, const ObjectPoints& world, const ObservationInput& obs, int frame, const Pose& X) const;
   // The side's ends' speed along the heading of scan f0 over f0 -> f1, if both show the side and
   // the pair counts (sidePairSpeed).

@@ -8,8 +8,8 @@
 #include <time.h>
 
 #include "../tests/backend_scene.hpp"
-#include "backend/heap_memory.hpp"
 #include "backend/sliding_window.hpp"
+#include "dlslot/heap_memory.hpp"
 #include "dlslot/timing_stats.hpp"
 
 using namespace dlslot;

@@ -12,15 +12,15 @@
 #include <stdexcept>
 
 #include "backend/backend_messages.hpp"
-#include "backend/heap_memory.hpp"
 #include "backend/object_points.hpp"
+#include "backend/sliding_window.hpp"
 #include "dlslot/convert.hpp"
-#include "dlslot/point_cloud_t.hpp"
 #include "dlslot/frame_joiner.hpp"
+#include "dlslot/heap_memory.hpp"
 #include "dlslot/kitti.hpp"
 #include "dlslot/lcm_log.hpp"
-#include "backend/sliding_window.hpp"
 #include "dlslot/node.hpp"
+#include "dlslot/point_cloud_t.hpp"
 #include "dlslot/timing_stats.hpp"
 
 using namespace dlslot;

@@ -14,6 +14,7 @@
 #include "detector/offline_eval.hpp"
 #include "dlslot/convert.hpp"
 #include "dlslot/detections_t.hpp"
+#include "dlslot/heap_memory.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/point_cloud_t.hpp"
 
@@ -89,6 +90,7 @@ int run(int argc, char** argv) {
   ConfigSection root_cfg = loadPipelineConfig(node_opts.config, channels);
   const DetectorConfig cfg = DetectorConfig::read(root_cfg.section("detector"));
   if (node_opts.check_config) return 0;
+  retainFreedMemory();  // a scan decoded every frame (heap_memory.hpp)
   if (!off.root.empty()) {
     const OfflineResult r = runOffline(off, cfg);
     if (eval || off.write_detections.empty()) std::fputs(formatResult(r, off).c_str(), stdout);

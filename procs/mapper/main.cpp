@@ -15,6 +15,7 @@
 
 #include "dlslot/convert.hpp"
 #include "dlslot/frame_joiner.hpp"
+#include "dlslot/heap_memory.hpp"
 #include "dlslot/lcm_log.hpp"
 #include "dlslot/message_guard.hpp"
 #include "dlslot/node.hpp"
@@ -313,6 +314,7 @@ int main(int argc, char** argv) {
     if (no_loops) config.loop.enabled = false;
     config.join_timeout_s = join_timeout.resolve(config.join_timeout_s);
     if (opts.check_config) return 0;
+    retainFreedMemory();  // a scan received every frame (heap_memory.hpp)
     if (!offline_in.empty()) return runOffline(config, channels, offline_in, out);
     return runLive(config, channels, opts, out);
   });

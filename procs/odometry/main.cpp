@@ -8,6 +8,7 @@
 #include "dlslot/convert.hpp"
 #include "dlslot/detections_t.hpp"
 #include "dlslot/frame_joiner.hpp"
+#include "dlslot/heap_memory.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/odometry_t.hpp"
 #include "dlslot/point_cloud_t.hpp"
@@ -176,6 +177,7 @@ int run(int argc, char** argv) {
   player.get("frame_period_s", offline.frame_period_s);
   if (!mode.empty()) cfg.remove_detected_objects = removesDetectedObjects(mode);
   if (node_opts.check_config) return 0;
+  retainFreedMemory();  // a scan decoded every frame (heap_memory.hpp)
 
   if (run_offline) {
     if (offline.root.empty() || offline.sequence.empty() || offline.out.empty())

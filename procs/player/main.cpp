@@ -12,6 +12,7 @@
 #include "dlslot/convert.hpp"
 #include "dlslot/detections_t.hpp"
 #include "dlslot/ground_truth_t.hpp"
+#include "dlslot/heap_memory.hpp"
 #include "dlslot/input_error.hpp"
 #include "dlslot/kitti.hpp"
 #include "dlslot/node.hpp"
@@ -75,6 +76,7 @@ int run(int argc, char** argv) {
   PlayerConfig cfg;
   cfg.read(root_cfg.section("player"));
   if (node_opts.check_config) return 0;
+  retainFreedMemory();  // a scan read, encoded and sent every frame (heap_memory.hpp)
   if (root.empty() == input.empty()) throw std::invalid_argument("give either --kitti ROOT or --input DIR");
   if (!input.empty() && calib_path.empty()) throw std::invalid_argument("--input needs --calib FILE (the sensor's YAML)");
   if (root.empty() && sequence.empty()) sequence = "input";

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <iostream>
 
+#include "dlslot/heap_memory.hpp"
 #include "dlslot/input_error.hpp"
 #include "dlslot/lcm_log.hpp"
 #include "dlslot/node.hpp"
@@ -170,6 +171,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (out.empty()) throw std::invalid_argument("--out DIR is required (see --help)");
+    retainFreedMemory();  // a scan decoded every frame (heap_memory.hpp)
     return log.empty() ? renderLive(opts, out, cfg, channels, skip_when_behind) : renderLog(log, out, cfg, channels);
   });
 }

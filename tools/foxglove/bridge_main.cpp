@@ -5,12 +5,11 @@
 // message is built only when a client subscribes to one of its topics, once for all clients;
 // each client has its own drop-oldest queue (client_queue.hpp), so a slow viewer loses old
 // frames, never slows the pipeline. PROCESS_STATUS counts clients, messages sent and dropped.
-#include <malloc.h>
-
 #include <chrono>
 #include <iostream>
 
 #include "dlslot/cpu_clock.hpp"
+#include "dlslot/heap_memory.hpp"
 #include "dlslot/node.hpp"
 #include "foxglove_convert.hpp"
 #include "ws_server.hpp"
@@ -42,12 +41,7 @@ int run(int argc, char** argv) {
   if (!(queue_mb > 0)) throw std::invalid_argument("--queue-mb: expected a positive size");
   server_opts.client_queue_bytes = static_cast<size_t>(queue_mb * (1 << 20));
 
-  // A scan is megabytes, built and freed 10-30 times a second. By default glibc hands blocks that
-  // large back to the kernel when they are freed (mmap, heap trimming) and the next scan faults
-  // them in again, zeroed: measured, most of the bridge's CPU went to page faults and clearing
-  // pages. Blocks up to 32 MB stay in the heap and the heap keeps up to 64 MB free at its top.
-  mallopt(M_MMAP_THRESHOLD, 32 << 20);
-  mallopt(M_TRIM_THRESHOLD, 64 << 20);
+  retainFreedMemory();  // a scan converted 10-30 times a second (heap_memory.hpp)
 
   foxglove::ConverterOptions conv_opts;
   conv_opts.scan_encoding = foxglove::ScanEncoding::kRos1;

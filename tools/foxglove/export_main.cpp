@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "dlslot/heap_memory.hpp"
 #include "dlslot/node.hpp"
 #include "dlslot/progress.hpp"
 #include "mcap_export.hpp"
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
     if (log.empty() || mcap.empty()) throw std::invalid_argument("--log RUN.lcmlog and --mcap OUT.mcap are required");
     Channels channels;
     loadPipelineConfig(config, channels);
+    retainFreedMemory();  // a scan converted every frame (heap_memory.hpp)
     ProgressLine progress("export " + mcap + " (MB of log)", 1);
     bool sized = false;
     const auto stats = foxglove::exportMcap(log, mcap, channels, [&](int64_t done, int64_t total) {

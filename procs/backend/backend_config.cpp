@@ -156,6 +156,7 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   require(c.registration_box_margin >= 0.0, s, "registration_box_margin", "a distance >= 0 (m)");
   s.get("registration_box_margin_sigmas", c.registration_box_margin_sigmas);
   require(c.registration_box_margin_sigmas >= 0.0, s, "registration_box_margin_sigmas", "a number >= 0 (standard deviations)");
+  s.get("registration_missed_vehicles", c.registration_missed_vehicles);
   s.get("line_of_sight_min_points", c.line_of_sight_min_points);
   require(c.line_of_sight_min_points >= 1, s, "line_of_sight_min_points", "an integer >= 1");
   s.get("line_of_sight_young_min_points", c.line_of_sight_young_min_points);
@@ -168,6 +169,10 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   require(c.line_of_sight_pairs >= 0, s, "line_of_sight_pairs", "an integer >= 0 (0: not used)");
   s.get("line_of_sight_sigma", c.line_of_sight_sigma);
   require(c.line_of_sight_sigma > 0.0, s, "line_of_sight_sigma", "a speed > 0 (m/s)");
+  s.get("line_of_sight_series", c.line_of_sight_series);
+  require(c.line_of_sight_series >= 0, s, "line_of_sight_series", "an integer >= 0 (scans; 0: pairs judged by their points alone)");
+  s.get("line_of_sight_tolerance", c.line_of_sight_tolerance);
+  require(c.line_of_sight_tolerance > 0.0, s, "line_of_sight_tolerance", "a distance > 0 (m)");
   s.get("line_of_sight_chain", c.line_of_sight_chain);
   s.get("side_azimuth_step_deg", c.side_azimuth_step_deg);
   require(c.side_azimuth_step_deg >= 0.0 && c.side_azimuth_step_deg < 10.0, s, "side_azimuth_step_deg",

@@ -97,6 +97,9 @@ struct BackendConfig {
   // truck's front face outside a 0.2 m margin in every other scan.
   double registration_box_margin = 0.2;
   double registration_box_margin_sigmas = 2.0;
+  // A moving vehicle the detector missed in a scan: its points there, cropped where its chain
+  // predicts it, measured as a detection's (SlidingWindow::addMissedVehicles).
+  bool registration_missed_vehicles = true;
   // A young vehicle without a registration: its speed along the line of sight from the face its
   // points show (line_of_sight.hpp), over the scan pairs with at least line_of_sight_min_points
   // in both scans (below 20, half the simulated pairs were more than 1 m/s off) among its last
@@ -109,6 +112,12 @@ struct BackendConfig {
   double line_of_sight_max_angle_deg = 10.0;  // the box's heading from the line of sight (facesTheSensor)
   int line_of_sight_pairs = 3;
   double line_of_sight_sigma = 0.3;
+  // A pair is judged by the face's last line_of_sight_series scans (this one included): it counts
+  // where both its scans lie within line_of_sight_tolerance (m) of the robust line through them,
+  // whatever its points, and never where one does not (faceSamplesOnLine; fewer than 4 of those
+  // scans: judged by its points as above; 0: never judged).
+  int line_of_sight_series = 6;
+  double line_of_sight_tolerance = 0.15;
   // Each pair also a factor on a vehicle's chain once it spans the window, for the frames no
   // registration measured (sight_speed_factor.hpp).
   bool line_of_sight_chain = true;

@@ -32,8 +32,8 @@ struct ObservationInput {
   bool dynamic_guess = false; // the tracker's preliminary static/dynamic guess
   bool confirmed = true;      // the tracker's lifecycle confirmed the track (tentative ones stay out of the graph)
   double confidence = 1.0;    // the track's confidence after this detection, [0, 1]
-  // The object's points in this scan (lidar frame; the node's selection by its box), when the
-  // scan arrived: per-object registration (object_registration.hpp).
+  // The object's points in this scan (lidar frame; selected by its box from BackendInput::scan),
+  // when the scan arrived: per-object registration (object_registration.hpp).
   std::shared_ptr<const ObjectPoints> points;
   // Which of its ends along the box's heading the scan saw whole (side_ends.hpp: endsSeen).
   EndsSeen ends_seen;
@@ -45,6 +45,11 @@ struct BackendInput {
   std::optional<OdometryInput> odometry;  // none: no ODOMETRY arrived for this frame
   bool associations_missing = false;      // no ASSOCIATIONS arrived: no objects this frame
   std::vector<ObservationInput> observations;
+  // This frame's scan (lidar frame) when the registration reads scans: each registered
+  // observation's points are cropped from it (attachObjectPoints), and those of the moving
+  // vehicles the detector missed in it, where their chains predict them. Without it, the points
+  // the observations carry.
+  std::shared_ptr<const PointCloud> scan;
 };
 
 struct TrackEstimate {
@@ -107,6 +112,9 @@ struct BackendOutput {
   int line_of_sight_pairs = 0;
   // And those whose side's ends gave its speed along its heading (side_ends.hpp).
   int side_pairs = 0;
+  // Vehicles the detector missed in this scan whose points, cropped where their chains predict
+  // them, were measured.
+  int missed_vehicles_measured = 0;
 };
 
 }  // namespace dlslot::backend

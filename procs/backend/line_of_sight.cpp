@@ -24,6 +24,30 @@ bool facesTheSensor(const Box& box, double max_angle_deg) {
   return along >= std::cos(max_angle_deg * M_PI / 180.0);
 }
 
+std::vector<bool> faceSamplesOnLine(const std::vector<double>& t, const std::vector<double>& y, double tolerance) {
+  const size_t n = std::min(t.size(), y.size());
+  if (n < 4) return {};
+  // Siegel's repeated median: each sample's median slope to the others, then their median.
+  std::vector<double> medians;
+  for (size_t i = 0; i < n; ++i) {
+    std::vector<double> slopes;
+    for (size_t j = 0; j < n; ++j)
+      if (j != i && t[j] != t[i]) slopes.push_back((y[j] - y[i]) / (t[j] - t[i]));
+    if (!slopes.empty()) medians.push_back(median(slopes));
+  }
+  if (medians.empty()) return {};
+  const double slope = median(medians);
+  std::vector<double> intercepts;
+  for (size_t i = 0; i < n; ++i) intercepts.push_back(y[i] - slope * t[i]);
+  const double intercept = median(intercepts);
+  std::vector<bool> on(n);
+  size_t count = 0;
+  for (size_t i = 0; i < n; ++i) count += on[i] = std::abs(y[i] - intercept - slope * t[i]) <= tolerance;
+  // With half of them off, the line is the outliers' as much as the face's.
+  if (2 * count <= n) on.assign(n, false);
+  return on;
+}
+
 std::optional<Eigen::Vector3d> lineOfSight(const ObjectPoints& points, const Eigen::Vector3d& sensor) {
   if (points.empty()) return std::nullopt;
   Eigen::Vector3d c = Eigen::Vector3d::Zero();

@@ -12,7 +12,6 @@
 #include <stdexcept>
 
 #include "backend/backend_messages.hpp"
-#include "backend/object_points.hpp"
 #include "backend/sliding_window.hpp"
 #include "dlslot/convert.hpp"
 #include "dlslot/frame_joiner.hpp"
@@ -35,6 +34,7 @@ struct OdometryPart {
 struct AssociationsPart {
   int64_t utime = 0;
   std::vector<ObservationInput> observations;
+  std::shared_ptr<const PointCloud> scan;  // the frame's, when it arrived (per-object registration)
 };
 using Joiner = FrameJoiner<OdometryPart, AssociationsPart>;
 
@@ -44,7 +44,10 @@ BackendInput toInput(const Joiner::Joined& j) {
   in.utime = j.a ? j.a->utime : j.b->utime;
   if (j.a) in.odometry = j.a->odometry;
   in.associations_missing = !j.b;
-  if (j.b) in.observations = j.b->observations;
+  if (j.b) {
+    in.observations = j.b->observations;
+    in.scan = j.b->scan;
+  }
   return in;
 }
 
@@ -98,6 +101,7 @@ void report(ProcessStatus& status, const BackendOutput& out) {
   if (out.registration_no_previous) status.count("registration_no_previous", out.registration_no_previous);
   if (out.line_of_sight_pairs) status.count("line_of_sight_pairs", out.line_of_sight_pairs);
   if (out.side_pairs) status.count("side_pairs", out.side_pairs);
+  if (out.missed_vehicles_measured) status.count("missed_vehicles_measured", out.missed_vehicles_measured);
   // The odometry factor's test (odometry_consistency.hpp): frames tested, and those where the
   // landmarks and objects disagreed with it beyond both covariances (down-weighted or reported).
   const OdometryCheck& c = out.odometry_check;
@@ -134,49 +138,30 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   // associations, but the player's next scans may too (the tracker answers later), so the newest
   // few are kept, as live.
   const bool use_scans = !config.registration_types.empty() && config.mode != Mode::kOdometryOnly;
-  std::map<int, PointCloud> scans;
+  std::map<int, std::shared_ptr<const PointCloud>> scans;
   std::map<std::string, FrameOrder> scan_order;
   LogEnvelopes envelopes(in_path);  // every event verified as it would be live (lcm_log.hpp)
-  for (; const lcm::LogEvent* raw = nextLogEvent(in, in_path); ++index) {
-    const lcm::LogEvent* ev = envelopes.open(*raw, guard, in_path + ": event " + std::to_string(index) + ": ");
-    if (!ev) continue;
-    if (use_scans && ev->channel == channels.scan) {
-      point_cloud_t m;
-      Refusal why = decodeChecked(ev->data, static_cast<size_t>(std::max(ev->datalen, 0)), &m);
-      if (!why) why = scan_order[ev->channel].accept(m.frame);
-      if (why) guard.refused(ev->channel, why, in_path + ": event " + std::to_string(index) + ": ");
-      else {
-        scans[m.frame] = dlslot::fromMsg(m);
-        while (scans.size() > 3) scans.erase(scans.begin());
-      }
-    } else if (ev->channel == channels.odometry) {
-      odometry_t m;
-      if (decode(*ev, &m)) joiner.addA(m.frame, OdometryPart{m.utime, fromMsg(m)}, 0.0);
-    } else if (ev->channel == channels.associations) {
-      associations_t m;
-      if (decode(*ev, &m)) {
-        AssociationsPart part{m.utime, observationsFromMsg(m, &rejected)};
-        if (const auto it = scans.find(m.frame); it != scans.end())
-          attachObjectPoints(it->second, config, part.observations);
-        joiner.addB(m.frame, std::move(part), 0.0);
-      }
-    }
-  }
-  int64_t refused = 0;
-  for (const auto& [what, n] : guard.refusals()) refused += n;
   SlidingWindow window(config);
   TimingStats total, solve, marginalize;
   int frames = 0, missing_odometry = 0, missing_associations = 0;
   int64_t landmarks = 0, moving = 0, switched = 0;  // summed over frames
   std::array<int64_t, kNumRegistrationOutcomes> registrations{};
-  int64_t registration_no_previous = 0, registration_points = 0, line_of_sight_pairs = 0, side_pairs = 0;
+  int64_t registration_no_previous = 0, registration_points = 0, line_of_sight_pairs = 0, side_pairs = 0, missed = 0;
   double registration_residual_sq = 0;
   int odometry_tested = 0, odometry_disagreed = 0, odometry_downweighted = 0;
   double odometry_max_disagreement_m = 0;
   std::vector<double> odometry_chi2;  // of the tested frames
   std::map<int, slot_state_t> states;
   std::map<int, int> inputs_left;  // frame -> its input events not yet copied to the output
-  for (const Joiner::Joined& j : joiner.flush()) {
+  // Frames are solved as they are released, as live: when both their parts are read, or a later
+  // frame's are (the other part is missing). So only the newest few scans are held. A part of a
+  // frame already solved is late, as live, and left out of the frame's inputs.
+  const auto late = [&](int frame) {
+    guard.warn(in_path + ": event " + std::to_string(index) + ": frame " + std::to_string(frame) +
+               " arrived after the frame was solved");
+    accepted.erase(index);
+  };
+  const auto solveFrame = [&](const Joiner::Joined& j) {
     BackendInput input = toInput(j);
     if (!ego_truth.empty()) useTrueEgo(ego_truth, ego_truth_path, input);
     const BackendOutput result = window.process(input);
@@ -194,6 +179,7 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
     registration_residual_sq += result.registration_residual_sq;
     line_of_sight_pairs += result.line_of_sight_pairs;
     side_pairs += result.side_pairs;
+    missed += result.missed_vehicles_measured;
     const OdometryCheck& check = result.odometry_check;
     odometry_tested += check.outcome != OdometryCheckOutcome::kUntested;
     if (check.outcome != OdometryCheckOutcome::kUntested) odometry_chi2.push_back(check.chi2);
@@ -205,7 +191,35 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
     }
     states[j.frame] = toMsg(result, toString(config.mode));
     inputs_left[j.frame] = (j.a ? 1 : 0) + (j.b ? 1 : 0);
+  };
+  for (; const lcm::LogEvent* raw = nextLogEvent(in, in_path); ++index) {
+    const lcm::LogEvent* ev = envelopes.open(*raw, guard, in_path + ": event " + std::to_string(index) + ": ");
+    if (!ev) continue;
+    if (use_scans && ev->channel == channels.scan) {
+      point_cloud_t m;
+      Refusal why = decodeChecked(ev->data, static_cast<size_t>(std::max(ev->datalen, 0)), &m);
+      if (!why) why = scan_order[ev->channel].accept(m.frame);
+      if (why) guard.refused(ev->channel, why, in_path + ": event " + std::to_string(index) + ": ");
+      else {
+        scans[m.frame] = std::make_shared<const PointCloud>(dlslot::fromMsg(m));
+        while (scans.size() > 3) scans.erase(scans.begin());
+      }
+    } else if (ev->channel == channels.odometry) {
+      odometry_t m;
+      if (decode(*ev, &m) && !joiner.addA(m.frame, OdometryPart{m.utime, fromMsg(m)}, 0.0)) late(m.frame);
+    } else if (ev->channel == channels.associations) {
+      associations_t m;
+      if (decode(*ev, &m)) {
+        AssociationsPart part{m.utime, observationsFromMsg(m, &rejected), nullptr};
+        if (const auto it = scans.find(m.frame); it != scans.end()) part.scan = it->second;
+        if (!joiner.addB(m.frame, std::move(part), 0.0)) late(m.frame);
+      }
+    }
+    for (const Joiner::Joined& j : joiner.release(0.0)) solveFrame(j);
   }
+  for (const Joiner::Joined& j : joiner.flush()) solveFrame(j);
+  int64_t refused = 0;
+  for (const auto& [what, n] : guard.refusals()) refused += n;
   if (!out_path.empty()) {
     // The output is the input run with this SLOT_STATE instead of the recorded one (if any):
     // every other event is copied in order, and a frame's SLOT_STATE follows its last input,
@@ -260,9 +274,9 @@ int runOffline(const BackendConfig& config, const Channels& channels, const std:
   std::printf("  per-object registrations:");
   for (int k = 0; k < kNumRegistrationOutcomes; ++k)
     std::printf(" %s %lld", toString(static_cast<RegistrationOutcome>(k)), static_cast<long long>(registrations[k]));
-  std::printf(", no previous scan %lld; line-of-sight pairs %lld, side pairs %lld\n",
+  std::printf(", no previous scan %lld; line-of-sight pairs %lld, side pairs %lld; missed vehicles measured %lld\n",
               static_cast<long long>(registration_no_previous), static_cast<long long>(line_of_sight_pairs),
-              static_cast<long long>(side_pairs));
+              static_cast<long long>(side_pairs), static_cast<long long>(missed));
   std::sort(odometry_chi2.begin(), odometry_chi2.end());
   const auto chi2At = [&](double q) {
     return odometry_chi2.empty() ? 0.0 : odometry_chi2[static_cast<size_t>(q * (odometry_chi2.size() - 1))];
@@ -306,16 +320,16 @@ int runLive(const BackendConfig& config, const Channels& channels, const NodeOpt
   });
   // The scans (per-object registration): the newest few, a frame's scan arrives before its
   // associations. Not subscribed when no class registers (nothing changes then).
-  std::map<int, PointCloud> scans;
+  std::map<int, std::shared_ptr<const PointCloud>> scans;
   if (!config.registration_types.empty() && config.mode != Mode::kOdometryOnly)
     node.subscribeFrames<point_cloud_t>(channels.scan, [&](const point_cloud_t& m) {
-      scans[m.frame] = dlslot::fromMsg(m);
+      scans[m.frame] = std::make_shared<const PointCloud>(dlslot::fromMsg(m));
       while (scans.size() > 3) scans.erase(scans.begin());
     });
   node.subscribeFrames<associations_t>(channels.associations, [&](const associations_t& m) {
     int rejected = 0;
-    AssociationsPart part{m.utime, observationsFromMsg(m, &rejected)};
-    if (const auto s = scans.find(m.frame); s != scans.end()) attachObjectPoints(s->second, config, part.observations);
+    AssociationsPart part{m.utime, observationsFromMsg(m, &rejected), nullptr};
+    if (const auto s = scans.find(m.frame); s != scans.end()) part.scan = s->second;
     if (rejected) node.status().error(std::to_string(rejected) + " malformed boxes in ASSOCIATIONS of frame " + std::to_string(m.frame));
     if (!joiner.addB(m.frame, std::move(part), nowSeconds()))
       node.status().warn("ASSOCIATIONS of frame " + std::to_string(m.frame) + " arrived after the frame was solved");

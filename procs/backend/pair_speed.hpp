@@ -25,11 +25,19 @@ struct PairSpeed {
   // measured with: speed x dt minus it is the motion against the sensor (sight_speed_factor.hpp).
   double sensor_displacement = 0;
   int points = 0;  // the fewer of the two scans' points
+  // Whether both scans lie on the line the face follows over its last scans (faceSamplesOnLine);
+  // nothing where too few scans tell.
+  std::optional<bool> on_line;
 };
+
+// Whether a pair counts by itself: where the face's scans judged it, their verdict; else when it
+// holds trusted_points points in both scans.
+bool countsAlone(const PairSpeed& p, int trusted_points);
 
 // The median of the counted pairs' speeds as a velocity measured along the newest counted pair's u
 // alone, with the median of their standard deviations there and no information across it. A pair
-// of fewer than trusted_points points counts only when another pair agrees with it, within two
+// judged off its face's line never counts; one that is not judged and holds fewer than
+// trusted_points points counts only when another pair not judged off its line agrees with it, within two
 // standard deviations of their difference: below 20 points 38 % of the line-of-sight pairs are
 // over 1 m/s off, and two such pairs rarely agree (the median of two pairs is their mean, so one
 // stray pair took a car's first velocity 6 m/s off). Nothing without pairs that count.

@@ -101,17 +101,16 @@ class SlidingWindow {
       Pose X_prev = Pose::Identity(), X_cur = Pose::Identity();
     };
     std::map<int, Motion> motions;
-    // The face along the line of sight in the latest scan that measured one (its frame, the
-    // direction and the face's range), and each scan pair's speed along it (frame t -> t-1 to t;
-    // line_of_sight.hpp).
+    // The face along the line of sight in its last scans that showed one (per frame: its points in
+    // the world, the direction and the face's range along it), and each scan pair's speed along it
+    // (frame t -> t-1 to t; line_of_sight.hpp).
     struct SightFace {
-      int frame = -1;
+      std::shared_ptr<const ObjectPoints> points;
       Eigen::Vector3d u = Eigen::Vector3d::UnitX();
       double range = 0;
-      int points = 0;
       Eigen::Vector3d sensor = Eigen::Vector3d::Zero();  // the ego position its points were put in the world with
     };
-    std::optional<SightFace> sight;
+    std::map<int, SightFace> sight_faces;
     std::map<int, PairSpeed> sight_speeds;
     // The scans whose box showed its side: its points (world), the box's heading d (world), one
     // end's standard deviation, which ends (along d) the scan saw and the ego position the points
@@ -142,10 +141,16 @@ class SlidingWindow {
   // previous scan alone, registration_model_frames 1), when it has both, and takes them into it.
   void registerPoints(Track& track, const ObservationInput& obs, int frame, const Pose& X, BackendOutput& out);
   bool registers(const std::string& type) const;
+  // Appends the moving vehicles the detector missed in this frame (none of the observations),
+  // each with its box where its chain predicts it (lidar frame of the ego pose X).
+  void addMissedVehicles(std::vector<ObservationInput>& observations, int frame, const Pose& X) const;
   // The face's range along the line of sight in this scan (world points) and, when the scan
   // before had one, the pair's speed along it (line_of_sight.hpp); true when it measured a pair.
   bool measureLineOfSight(Track& track, const ObjectPoints& world, const Box& box, int frame, const Pose& X,
                           double dt) const;
+  // Each kept pair of the face's scans judged by the line through them all (faceSamplesOnLine),
+  // this frame's scan the newest.
+  void judgeFacePairs(Track& track, int frame) const;
   // This scan's points when its box shows the side (side_ends.hpp) and, when the scan before did
   // too and the pair counts, the pair's speed; true when it measured a pair.
   bool measureSideEnds(Track& track, const ObjectPoints& world, const ObservationInput& obs, int frame, const Pose& X) const;

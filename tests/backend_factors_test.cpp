@@ -712,7 +712,7 @@ TEST(BackendConfig, ShippedConfigReadsAndSqrtInformation) {
   EXPECT_EQ(c.vehicle_lateral_jerk, 1.0);
   for (const char* bad : {"-0.5", "sharp"}) expectRefused("vehicle_lateral_jerk", bad);
   EXPECT_EQ(c.line_of_sight_series, 6);
-  for (const char* bad : {"-1", "six"}) expectRefused("line_of_sight_series", bad);
+  for (const char* bad : {"-1", "11", "six"}) expectRefused("line_of_sight_series", bad);  // window_size 10
   EXPECT_EQ(c.line_of_sight_tolerance, 0.15);
   expectRefused("line_of_sight_tolerance", "0");
   EXPECT_TRUE(c.registration_missed_vehicles);

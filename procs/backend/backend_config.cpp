@@ -170,7 +170,9 @@ BackendConfig BackendConfig::read(ConfigSection& s) {
   s.get("line_of_sight_sigma", c.line_of_sight_sigma);
   require(c.line_of_sight_sigma > 0.0, s, "line_of_sight_sigma", "a speed > 0 (m/s)");
   s.get("line_of_sight_series", c.line_of_sight_series);
-  require(c.line_of_sight_series >= 0, s, "line_of_sight_series", "an integer >= 0 (scans; 0: pairs judged by their points alone)");
+  // Its scans' times are the window's.
+  require(c.line_of_sight_series >= 0 && c.line_of_sight_series <= c.window_size, s, "line_of_sight_series",
+          "an integer in [0, window_size] (scans; 0: pairs judged by their points alone)");
   s.get("line_of_sight_tolerance", c.line_of_sight_tolerance);
   require(c.line_of_sight_tolerance > 0.0, s, "line_of_sight_tolerance", "a distance > 0 (m)");
   s.get("line_of_sight_chain", c.line_of_sight_chain);

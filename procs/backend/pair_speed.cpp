@@ -17,7 +17,8 @@ std::optional<VelocityEvidence> medianPairVelocity(const std::vector<PairSpeed>&
   for (const PairSpeed& p : pairs) {
     if (!(p.sigma > 0)) continue;
     const auto agrees = [&](const PairSpeed& q) {
-      return &q != &p && q.sigma > 0 && q.on_line.value_or(true) && std::abs(q.speed - p.speed) <= 2.0 * std::hypot(p.sigma, q.sigma);
+      return &q != &p && q.sigma > 0 && q.on_line.value_or(true) &&
+             std::abs(q.speed - p.speed) <= 2.0 * std::hypot(p.sigma, q.sigma);
     };
     if (!countsAlone(p, trusted_points) && (p.on_line || std::none_of(pairs.begin(), pairs.end(), agrees))) continue;
     speeds.push_back(p.speed);

@@ -37,10 +37,10 @@ bool countsAlone(const PairSpeed& p, int trusted_points);
 // The median of the counted pairs' speeds as a velocity measured along the newest counted pair's u
 // alone, with the median of their standard deviations there and no information across it. A pair
 // judged off its face's line never counts; one that is not judged and holds fewer than
-// trusted_points points counts only when another pair not judged off its line agrees with it, within two
-// standard deviations of their difference: below 20 points 38 % of the line-of-sight pairs are
-// over 1 m/s off, and two such pairs rarely agree (the median of two pairs is their mean, so one
-// stray pair took a car's first velocity 6 m/s off). Nothing without pairs that count.
+// trusted_points points counts only when another pair not judged off its line agrees with it,
+// within two standard deviations of their difference: below 20 points 38 % of the line-of-sight
+// pairs are over 1 m/s off, and two such pairs rarely agree (the median of two pairs is their mean,
+// so one stray pair took a car's first velocity 6 m/s off). Nothing without pairs that count.
 std::optional<VelocityEvidence> medianPairVelocity(const std::vector<PairSpeed>& pairs, int trusted_points = 0);
 
 }  // namespace dlslot::backend

@@ -275,8 +275,9 @@ void SlidingWindow::addMissedVehicles(std::vector<ObservationInput>& observation
     obs.box.center = b.translation();
     obs.box.yaw = yawOf(b.linear());
     obs.box.size = track.size;
-    const double margin = std::max(config_.registration_box_margin, config_.registration_box_margin_sigmas *
-                                                                         config_.boxLengthwiseSigma(obs.box.center.norm()));
+    const double margin =
+        std::max(config_.registration_box_margin,
+                 config_.registration_box_margin_sigmas * config_.boxLengthwiseSigma(obs.box.center.norm()));
     const double sigma = std::sqrt(track.velocity_covariance.topLeftCorner<2, 2>().trace()) * gap;
     if (gap > 0 && sigma <= 0.5 * margin) observations.push_back(obs);
   }

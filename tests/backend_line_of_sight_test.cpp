@@ -143,6 +143,13 @@ TEST(LineOfSight, AJudgedPairCountsByItsVerdictWhateverItsPoints) {
 
 namespace {
 
+// A car at 15 m/s that brakes at 3 m/s^2 from t_brake on: the distance it has driven and its
+// speed at time t.
+std::pair<double, double> brakingCar(double t, double t_brake) {
+  const double tb = std::clamp(t - t_brake, 0.0, 5.0);
+  return {15.0 * std::min(t, t_brake) + 15.0 * tb - 1.5 * tb * tb, t < t_brake ? 15.0 : 15.0 - 3.0 * tb};
+}
+
 // A young oncoming car 70 -> 55 m ahead at 25 m/s, its boxes as far off as the backend's noise
 // model says (0.105 m x (1 + 0.035 x 65 m) = 0.34 m, config/dlslot.yaml), the ego stopped: the RMS
 // error of its published velocity over its young frames, with and without the line of sight.
@@ -174,10 +181,7 @@ struct BrakingErrors {
   double rmse = 0, mean = 0;
 };
 BrakingErrors brakingOncomingCar(bool on_chain) {
-  const auto along = [](double t) {  // distance driven and speed
-    const double tb = std::clamp(t - 1.0, 0.0, 5.0);
-    return std::make_pair(15.0 * std::min(t, 1.0) + 15.0 * tb - 1.5 * tb * tb, t < 1.0 ? 15.0 : 15.0 - 3.0 * tb);
-  };
+  const auto along = [](double t) { return brakingCar(t, 1.0); };
   SimScene scene = oneCar([along](double t) { return planarPose(100.0 - along(t).first, 3.5, M_PI); }, 0.36);
   scene.ego = constantTwist(Pose::Identity(), 5.0, 0.0);
   BackendConfig c = registrationHeldOff();
@@ -221,10 +225,7 @@ namespace {
 // frame.
 std::vector<double> brakingOncomingErrorByFrame() {
   constexpr int kFrames = 18, kDrives = 30;
-  const auto along = [](double t) {  // distance driven and speed
-    const double tb = std::clamp(t - 0.5, 0.0, 5.0);
-    return std::make_pair(15.0 * std::min(t, 0.5) + 15.0 * tb - 1.5 * tb * tb, t < 0.5 ? 15.0 : 15.0 - 3.0 * tb);
-  };
+  const auto along = [](double t) { return brakingCar(t, 0.5); };
   std::vector<double> sq(kFrames, 0.0);
   std::vector<int> n(kFrames, 0);
   for (int drive = 0; drive < kDrives; ++drive) {
@@ -269,10 +270,7 @@ namespace {
 // detector misses it in every third frame (miss_every; its points are still in the scan, which
 // the backend crops from: BackendInput::scan). Over ten drives.
 double brakingCarError(const BackendConfig& c, int bonnet_every, int miss_every, int* missed_measured = nullptr) {
-  const auto along = [](double t) {
-    const double tb = std::clamp(t - 1.0, 0.0, 5.0);
-    return std::make_pair(15.0 * std::min(t, 1.0) + 15.0 * tb - 1.5 * tb * tb, t < 1.0 ? 15.0 : 15.0 - 3.0 * tb);
-  };
+  const auto along = [](double t) { return brakingCar(t, 1.0); };
   double sq = 0;
   int n = 0;
   for (unsigned seed = 1; seed <= 10; ++seed) {
